@@ -1,0 +1,60 @@
+// resoct single-source kernel: the bridge between C++ (with GLM) and GLSL.
+//
+// Every include/resoct/kernel/*.glsl.h is written in the common subset of C++20 and GLSL 4.50 and
+// includes this file first. In C++ the kernel lives in namespace resoct::kernel with GLM's
+// vector types and functions in scope; in GLSL it is global. Write only what both languages
+// accept: no pointers, references, templates or classes; no implicit int/uint/float conversions
+// (GLSL rejects them); literals with explicit suffixes (1u, 1.0f); structs of scalars only.
+//
+// Portable spellings:
+//   RESOCT_FN                 before every function: `inline` in C++, nothing in GLSL
+//   RESOCT_OUT(T), RESOCT_INOUT(T)   parameter qualifiers: T& in C++, out/inout T in GLSL
+//   RESOCT_CONST(T, name, v)  a compile-time constant visible to both languages
+//   RESOCT_KERNEL_BEGIN / _END     open and close namespace resoct::kernel in C++ only
+#ifndef RESOCT_KERNEL_COMMON_GLSL_H
+#define RESOCT_KERNEL_COMMON_GLSL_H
+
+#ifdef __cplusplus
+#include <cstdint>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/packing.hpp>
+
+namespace resoct::kernel {
+using namespace glm;
+using uint = std::uint32_t;
+
+// GLSL built-ins that GLM spells differently or lacks.
+inline float uintBitsToFloat(uint v) {
+  return glm::uintBitsToFloat(v);
+}
+inline uint floatBitsToUint(float v) {
+  return glm::floatBitsToUint(v);
+}
+inline int findLSB(uint v) {
+  return v == 0u ? -1 : __builtin_ctz(v);
+}
+inline int findMSB(uint v) {
+  return v == 0u ? -1 : 31 - __builtin_clz(v);
+}
+inline int bitCount(uint v) {
+  return __builtin_popcount(v);
+}
+}  // namespace resoct::kernel
+
+#define RESOCT_FN inline
+#define RESOCT_OUT(T) T&
+#define RESOCT_INOUT(T) T&
+#define RESOCT_CONST(T, name, value) inline constexpr T name = value
+#define RESOCT_KERNEL_BEGIN namespace resoct::kernel {
+#define RESOCT_KERNEL_END }
+#else
+#define RESOCT_FN
+#define RESOCT_OUT(T) out T
+#define RESOCT_INOUT(T) inout T
+#define RESOCT_CONST(T, name, value) const T name = value
+#define RESOCT_KERNEL_BEGIN
+#define RESOCT_KERNEL_END
+#endif
+
+#endif  // RESOCT_KERNEL_COMMON_GLSL_H
