@@ -1,0 +1,49 @@
+# Packaging check, run by ctest: install resoct into a fresh prefix, then configure, build and run
+# examples/from_install against (1) the install tree and (2) the build tree.
+# Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "cpu;vulkan")
+foreach(v SOURCE_DIR BINARY_DIR WORK_DIR COMPONENTS)
+  if(NOT DEFINED ${v})
+    message(FATAL_ERROR "check_package.cmake: -D${v}= is required")
+  endif()
+endforeach()
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+endfunction()
+
+file(REMOVE_RECURSE ${WORK_DIR})
+set(prefix ${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${prefix})
+foreach(f include/resoct/hierarchy.hpp lib/cmake/resoct/resoctConfig.cmake
+          lib/cmake/resoct/resoctConfigVersion.cmake)
+  if(NOT EXISTS ${prefix}/${f})
+    message(FATAL_ERROR "install tree lacks ${f}")
+  endif()
+endforeach()
+
+string(REPLACE ";" "\\;" comps "${COMPONENTS}")
+foreach(kind install build)
+  if(kind STREQUAL "install")
+    set(locate -DCMAKE_PREFIX_PATH=${prefix})
+  else()
+    set(locate -Dresoct_DIR=${BINARY_DIR})
+  endif()
+  set(bdir ${WORK_DIR}/consumer-${kind})
+  run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/from_install -B ${bdir} -G Ninja
+      -DCMAKE_BUILD_TYPE=Release ${locate} "-DRESOCT_CONSUMER_COMPONENTS=${comps}")
+  run(${CMAKE_COMMAND} --build ${bdir})
+  run(${bdir}/consumer)
+  message(STATUS "consumer against the ${kind} tree: ok")
+endforeach()
+
+# A component that was not built must make find_package fail, not silently succeed.
+set(bdir ${WORK_DIR}/consumer-missing)
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/from_install -B ${bdir} -G Ninja
+                -DCMAKE_PREFIX_PATH=${prefix} -DRESOCT_CONSUMER_COMPONENTS=cpu\;nonexistent
+                RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+if(rc EQUAL 0)
+  message(FATAL_ERROR "find_package succeeded with a nonexistent component")
+endif()
