@@ -120,7 +120,12 @@ class Pipeline {
         order_(h_),
         window_(std::max<std::uint64_t>(8, 4u * std::uint64_t(threads))) {
     ring_.resize(std::size_t(window_));
-    for (std::uint32_t t = 0; t < threads; ++t) workers_.emplace_back([this] { work(); });
+    try {
+      for (std::uint32_t t = 0; t < threads; ++t) workers_.emplace_back([this] { work(); });
+    } catch (...) {
+      stop();  // joinable threads must not outlive a constructor that throws
+      throw;
+    }
   }
   ~Pipeline() { stop(); }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <random>
 #include <set>
 
 #include "resoct/brick_store.hpp"
@@ -315,5 +316,79 @@ TEST_P(CorruptStore, EachFailureClassHasItsOwnCode) {
 
 INSTANTIATE_TEST_SUITE_P(Codecs, CorruptStore, ::testing::Values(Codec::lz4, Codec::zstd),
                          [](const auto& p) { return std::string(to_string(p.param)); });
+
+}  // namespace
+
+namespace {
+
+// Random values in header fields and index entries with every checksum recomputed, so that the
+// field validation itself (not the CRC) must catch them. Opening and reading must either work or
+// throw resoct::Error naming the file; nothing may crash or allocate absurdly.
+TEST_P(CorruptStore, RandomFieldsWithValidChecksumsNeverCrash) {
+  std::mt19937_64 rng(2024);
+  const std::vector<std::pair<std::size_t, int>> header_fields = {{lay::flags, 4},
+                                                                  {20, 4},
+                                                                  {lay::extent, 8},
+                                                                  {lay::extent + 8, 8},
+                                                                  {lay::extent + 16, 8},
+                                                                  {48, 8},
+                                                                  {lay::channels, 4},
+                                                                  {lay::brick_size, 4},
+                                                                  {lay::brick_size + 8, 4},
+                                                                  {88, 4},
+                                                                  {92, 4},
+                                                                  {96, 4},
+                                                                  {100, 4},
+                                                                  {104, 4},
+                                                                  {112, 8},
+                                                                  {lay::payload_offset, 8},
+                                                                  {lay::payload_size, 8},
+                                                                  {lay::index_offset, 8},
+                                                                  {lay::index_size, 8},
+                                                                  {lay::metadata_offset, 8},
+                                                                  {lay::metadata_size, 8},
+                                                                  {168, 8},
+                                                                  {184, 8},
+                                                                  {192, 8}};
+  const std::size_t entries = sec_.index_size / lay::entry_size;
+  int opened = 0, rejected = 0;
+  for (int round = 0; round < 120; ++round) {
+    std::vector<std::uint8_t> b = bytes_;
+    if (round % 2 == 0) {
+      const auto [at, width] = header_fields[std::size_t(rng() % header_fields.size())];
+      // Small values, powers of two and arbitrary bits: the interesting neighbourhoods.
+      const std::uint64_t v = round % 6 == 0   ? rng() % 64
+                              : round % 6 == 2 ? 1ull << (rng() % 63)
+                                               : rng();
+      put_le(b, at, v, width);
+      test::fix_header_crc(b);
+    } else {
+      const std::size_t e = sec_.index + std::size_t(rng() % entries) * lay::entry_size;
+      const std::size_t field = std::size_t(rng() % 10) * 4;
+      put_le(b, e + field, round % 3 == 0 ? rng() % 8 : rng(), 4);
+      test::fix_index_crc(b);
+    }
+    test::write_bytes(bad_, b);
+    try {
+      const BrickStoreSource store(bad_);
+      ++opened;
+      const BrickLayout& layout = store.hierarchy().layout();
+      ASSERT_LE(layout.padded_voxels(), 1u << 20) << "accepted an altered brick size";
+      for (const BrickKey k : keys()) {
+        std::vector<std::byte> out(layout.padded_voxels() * voxel_size(store.volume().type));
+        try {
+          store.read_brick(k, out);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find(bad_), std::string::npos) << e.what();
+        }
+      }
+    } catch (const Error& e) {
+      ++rejected;
+      EXPECT_NE(std::string(e.what()).find(bad_), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(rejected, 60);  // most random values are impossible and must be refused
+  EXPECT_EQ(opened + rejected, 120);
+}
 
 }  // namespace
