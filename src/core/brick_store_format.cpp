@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -152,6 +154,9 @@ StoreHeader decode_header(const ReadFile& file) {
   if ((h.flags & ~kKnownFlags) != 0) {
     throw fail(ErrorCode::unsupported, hdr::flags,
                "unknown header flags " + std::to_string(h.flags & ~kKnownFlags));
+  }
+  if (get_u32(b, hdr::reserved) != 0) {
+    throw fail(ErrorCode::corrupt, hdr::reserved, "reserved header field is not zero");
   }
   const std::uint32_t channels = get_u32(b, hdr::channels);
   if (channels == 0 || channels > kMaxChannels) {

@@ -326,30 +326,14 @@ namespace {
 // throw resoct::Error naming the file; nothing may crash or allocate absurdly.
 TEST_P(CorruptStore, RandomFieldsWithValidChecksumsNeverCrash) {
   std::mt19937_64 rng(2024);
-  const std::vector<std::pair<std::size_t, int>> header_fields = {{lay::flags, 4},
-                                                                  {20, 4},
-                                                                  {lay::extent, 8},
-                                                                  {lay::extent + 8, 8},
-                                                                  {lay::extent + 16, 8},
-                                                                  {48, 8},
-                                                                  {lay::channels, 4},
-                                                                  {lay::brick_size, 4},
-                                                                  {lay::brick_size + 8, 4},
-                                                                  {88, 4},
-                                                                  {92, 4},
-                                                                  {96, 4},
-                                                                  {100, 4},
-                                                                  {104, 4},
-                                                                  {112, 8},
-                                                                  {lay::payload_offset, 8},
-                                                                  {lay::payload_size, 8},
-                                                                  {lay::index_offset, 8},
-                                                                  {lay::index_size, 8},
-                                                                  {lay::metadata_offset, 8},
-                                                                  {lay::metadata_size, 8},
-                                                                  {168, 8},
-                                                                  {184, 8},
-                                                                  {192, 8}};
+  // clang-format off
+  const std::vector<std::pair<std::size_t, int>> header_fields = {
+      {lay::flags, 4}, {20, 4}, {lay::extent, 8}, {lay::extent + 8, 8}, {lay::extent + 16, 8},
+      {48, 8}, {lay::channels, 4}, {lay::brick_size, 4}, {lay::brick_size + 8, 4}, {88, 4},
+      {92, 4}, {96, 4}, {100, 4}, {104, 4}, {112, 8}, {lay::payload_offset, 8},
+      {lay::payload_size, 8}, {lay::index_offset, 8}, {lay::index_size, 8},
+      {lay::metadata_offset, 8}, {lay::metadata_size, 8}, {168, 8}, {180, 4}, {184, 8}, {192, 8}};
+  // clang-format on
   const std::size_t entries = sec_.index_size / lay::entry_size;
   int opened = 0, rejected = 0;
   for (int round = 0; round < 120; ++round) {
