@@ -1,0 +1,32 @@
+#include <limits>
+
+#include "resoct/brick_store.hpp"
+
+namespace resoct {
+
+double StoreLevelStats::compression_ratio() const noexcept {
+  if (compressed_bytes == 0) return std::numeric_limits<double>::infinity();
+  return double(uncompressed_bytes) / double(compressed_bytes);
+}
+
+double StoreLevelStats::empty_fraction() const noexcept {
+  return brick_count == 0 ? 0.0 : double(empty_bricks) / double(brick_count);
+}
+
+StoreLevelStats StoreStats::total() const noexcept {
+  StoreLevelStats t;
+  for (const StoreLevelStats& l : levels) {
+    t.brick_count += l.brick_count;
+    t.constant_bricks += l.constant_bricks;
+    t.empty_bricks += l.empty_bricks;
+    t.compressed_bytes += l.compressed_bytes;
+    t.uncompressed_bytes += l.uncompressed_bytes;
+  }
+  if (!levels.empty()) {
+    t.extent = levels.front().extent;
+    t.bricks = levels.front().bricks;
+  }
+  return t;
+}
+
+}  // namespace resoct
