@@ -8,9 +8,11 @@
 /// box = p * box_extent.
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "resoct/hierarchy.hpp"
 #include "resoct/volume_desc.hpp"
 
 namespace resoct {
@@ -50,6 +52,15 @@ glm::dvec3 box_to_normalized(const VolumeDesc& volume, const glm::dvec3& box_pos
 glm::dvec3 normalized_to_box(const VolumeDesc& volume, const glm::dvec3& normalized);
 /// Size of one level-0 voxel in box units per axis: spacing / max(physical_size).
 glm::dvec3 box_voxel_size(const VolumeDesc& volume);
+
+/// Voxel size of level `l` in box units per axis: box_voxel_size * 2^factor_log2.
+glm::dvec3 level_voxel_size(const BrickHierarchy& hierarchy, std::uint32_t l);
+/// Per level, log2 of the largest voxel dimension in box units (non-decreasing): the table the
+/// kernel's LOD selection reads through resoct_read_level_size_log2 (docs/rendering.md).
+std::vector<float> level_size_log2_table(const BrickHierarchy& hierarchy);
+/// The reference step Δ₀ of transfer-function alpha: the smallest level-0 voxel dimension in box
+/// units.
+double reference_step_length(const VolumeDesc& volume);
 
 /// Ray generation for one camera and viewport. Pixel (x, y) has its centre at (x + 0.5, y + 0.5)
 /// with y = 0 the top row; pixels are square (the horizontal field follows the aspect ratio).

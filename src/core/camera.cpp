@@ -1,5 +1,6 @@
 #include "resoct/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -36,6 +37,27 @@ glm::dvec3 normalized_to_box(const VolumeDesc& volume, const glm::dvec3& normali
 
 glm::dvec3 box_voxel_size(const VolumeDesc& volume) {
   return box_extent(volume) / glm::dvec3(volume.extent);
+}
+
+glm::dvec3 level_voxel_size(const BrickHierarchy& hierarchy, std::uint32_t l) {
+  const glm::uvec3 f = hierarchy.level(l).factor_log2;
+  const glm::dvec3 h = box_voxel_size(hierarchy.volume());
+  return {std::ldexp(h.x, int(f.x)), std::ldexp(h.y, int(f.y)), std::ldexp(h.z, int(f.z))};
+}
+
+std::vector<float> level_size_log2_table(const BrickHierarchy& hierarchy) {
+  std::vector<float> out;
+  out.reserve(hierarchy.level_count());
+  for (std::uint32_t l = 0; l < hierarchy.level_count(); ++l) {
+    const glm::dvec3 s = level_voxel_size(hierarchy, l);
+    out.push_back(float(std::log2(std::max(s.x, std::max(s.y, s.z)))));
+  }
+  return out;
+}
+
+double reference_step_length(const VolumeDesc& volume) {
+  const glm::dvec3 h = box_voxel_size(volume);
+  return std::min(h.x, std::min(h.y, h.z));
 }
 
 CameraRays::CameraRays(const Camera& camera, const Viewport& viewport)

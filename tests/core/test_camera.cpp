@@ -109,4 +109,30 @@ TEST(Camera, BoxAndNormalizedCoordinates) {
   expect_vec_near(box_to_normalized(v, normalized_to_box(v, p)), p, 1e-15);
 }
 
+TEST(Camera, LevelVoxelSizesFollowTheHierarchy) {
+  // 1024 x 1024 x 40 with spacing 1:1:20 (32^3 bricks): the hierarchy halves x and y first
+  // (docs/hierarchy.md), so the largest voxel dimension stays the z spacing for a while.
+  VolumeDesc v;
+  v.extent = {1024, 1024, 40};
+  v.spacing = {1.0, 1.0, 20.0};
+  const BrickHierarchy hier(v, BrickLayout{});
+  const glm::dvec3 h = box_voxel_size(v);  // physical 1024 x 1024 x 800: h = (1, 1, 20) / 1024
+  expect_vec_near(h, glm::dvec3(1.0, 1.0, 20.0) / 1024.0, 1e-15);
+  const std::vector<float> table = level_size_log2_table(hier);
+  ASSERT_EQ(table.size(), hier.level_count());
+  for (std::uint32_t l = 0; l < hier.level_count(); ++l) {
+    const glm::uvec3 f = hier.level(l).factor_log2;
+    // Brute force from the definition: level voxel = 2^f level-0 voxels per axis.
+    const glm::dvec3 size =
+        glm::dvec3(std::pow(2.0, f.x), std::pow(2.0, f.y), std::pow(2.0, f.z)) * h;
+    expect_vec_near(level_voxel_size(hier, l), size, 1e-15);
+    EXPECT_NEAR(table[l], std::log2(std::max(size.x, std::max(size.y, size.z))), 1e-6);
+    if (l > 0) {
+      EXPECT_GE(table[l], table[l - 1]);
+    }
+  }
+  EXPECT_NEAR(table[0], std::log2(20.0 / 1024.0), 1e-6);
+  EXPECT_DOUBLE_EQ(reference_step_length(v), 1.0 / 1024.0);
+}
+
 }  // namespace
