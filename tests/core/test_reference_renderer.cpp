@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "support/expect_error.hpp"
 #include "support/reference_renderer.hpp"
 
 namespace {
@@ -105,8 +106,7 @@ TEST(ReferenceRenderer, TrilinearReproducesLinearRampsExactly) {
   const glm::u64vec3 extent(7, 5, 11);
   const glm::dvec4 k(0.3, -1.7, 2.25, 4.0);
   const VoxelFunction ramp = [&](std::uint32_t, const glm::i64vec3& i) {
-    return k.x * (double(i.x) + 0.5) + k.y * (double(i.y) + 0.5) + k.z * (double(i.z) + 0.5) +
-           k.w;
+    return k.x * (double(i.x) + 0.5) + k.y * (double(i.y) + 0.5) + k.z * (double(i.z) + 0.5) + k.w;
   };
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -178,6 +178,46 @@ TEST(ReferenceRenderer, TwoIdenticalChannelsEqualOneDenserChannel) {
   const glm::vec4 mid = c.at(8, 8);
   EXPECT_NEAR(mid.r, mid.b, 1e-6);
   EXPECT_GT(mid.r, 0.1f);
+}
+
+TEST(ReferenceRenderer, DefaultStepHasConverged) {
+  // A smooth random two-channel field seen in perspective: halving the default step of 1/16
+  // voxel changes the image by far less than one 8-bit level, so the oracle's step is "tiny".
+  VolumeDesc v;
+  v.extent = {12, 10, 9};
+  v.channels = 2;
+  v.type = VoxelType::f32;
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<double>> data(2, std::vector<double>(12 * 10 * 9));
+  for (auto& ch : data) {
+    for (double& x : ch) x = u(rng);
+  }
+  const VoxelFunction voxels = resoct::test::dense_voxels(v.extent, data);
+  Scene s;
+  s.camera.eye = {1.8, 0.9, 1.6};
+  s.camera.target = {0.5, 0.4, 0.4};
+  s.viewport = {24, 24};
+  ChannelSettings a;
+  a.channel = 0;
+  a.tf = TransferFunction({{0.2, {1, 0.5, 0, 0}}, {0.8, {1, 0.8, 0.2, 0.3}}});
+  ChannelSettings b;
+  b.channel = 1;
+  b.tf = TransferFunction({{0.4, {0, 0.3, 1, 0}}, {1.0, {0.2, 0.6, 1, 0.5}}});
+  s.channels = {a, b};
+  const Image fine =
+      resoct::test::render_reference(s, v, voxels, ReferenceOptions{1.0 / 32.0, true});
+  const Image dflt = resoct::test::render_reference(s, v, voxels);
+  const ImageDiff d = compare_images(fine, dflt);
+  EXPECT_LT(d.max_abs.r, 0.5 / 255.0);
+  EXPECT_LT(d.max_abs.g, 0.5 / 255.0);
+  EXPECT_LT(d.max_abs.b, 0.5 / 255.0);
+  // And the image is not trivially empty.
+  double sum = 0.0;
+  for (const glm::vec4& p : dflt.pixels()) sum += p.r + p.b;
+  EXPECT_GT(sum, 1.0);
+  EXPECT_RESOCT_ERROR(resoct::test::dense_voxels(v.extent, {std::vector<double>(5)}),
+                      ErrorCode::size_mismatch, "channel 0 has 5 values");
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ void main() {
   vec2 tn = resoct_ray_node_local(rel, dir, vec3(16.0f));
 
   float dt = resoct_step_size(dir, vec3(1.0f / 256.0f), 1.0f, 1.0e-6f);
-  float t = resoct_advance_t(tt.x, dt);
+  float t = resoct_advance_t(tt.x, resoct_segment_length(tt.x, dt, tt.y));
   float fp = resoct_pixel_footprint(0.0f, 0.01f, t);
   float budget = resoct_lod_budget_log2(0.0f, 0.01f, t, 1.0f);
   uint lod = resoct_lod_level(budget, 9u);

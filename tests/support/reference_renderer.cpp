@@ -10,6 +10,22 @@
 
 namespace resoct::test {
 
+VoxelFunction dense_voxels(const glm::u64vec3& extent, std::vector<std::vector<double>> channels) {
+  const std::uint64_t count = extent.x * extent.y * extent.z;
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    if (channels[c].size() != count) {
+      throw Error(ErrorCode::size_mismatch, "dense_voxels: channel " + std::to_string(c) + " has " +
+                                                std::to_string(channels[c].size()) +
+                                                " values, expected " + std::to_string(count));
+    }
+  }
+  return [extent, data = std::move(channels)](std::uint32_t channel, const glm::i64vec3& v) {
+    const std::uint64_t i =
+        (std::uint64_t(v.z) * extent.y + std::uint64_t(v.y)) * extent.x + std::uint64_t(v.x);
+    return data.at(channel).at(i);
+  };
+}
+
 double sample_trilinear(const VoxelFunction& voxels, std::uint32_t channel,
                         const glm::u64vec3& extent, const glm::dvec3& pos) {
   glm::i64vec3 i0;

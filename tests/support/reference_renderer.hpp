@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
@@ -27,6 +28,10 @@ namespace resoct::test {
 
 /// Raw value of `channel` at level-0 voxel `voxel` (always inside the extent).
 using VoxelFunction = std::function<double(std::uint32_t channel, const glm::i64vec3& voxel)>;
+
+/// A VoxelFunction over dense level-0 buffers, one per channel, x fastest then y then z. Throws
+/// Error(size_mismatch) when a buffer does not hold extent.x * extent.y * extent.z values.
+VoxelFunction dense_voxels(const glm::u64vec3& extent, std::vector<std::vector<double>> channels);
 
 struct ReferenceOptions {
   /// Step length in reference steps Δ₀ (Δ₀ = smallest level-0 voxel dimension in box units).

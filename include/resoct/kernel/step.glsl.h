@@ -9,7 +9,8 @@
 // voxels per box unit, 1 / h_i). dt = max(min_i dt_i * step_scale, min_step) (Eq. 8.3 plus a
 // floor). Components with |d_i| < RESOCT_RAY_PARALLEL_EPS impose no limit; a zero direction
 // falls back to the smallest h_i. resoct_advance_t guarantees t strictly increases even where
-// t + dt rounds back to t.
+// t + dt rounds back to t. Segments [t, t + dt) are cut at the exit (resoct_segment_length) and
+// sampled at their midpoints.
 //
 // Level of detail: a pixel's world footprint at view depth z is footprint_base +
 // footprint_slope * z (orthographic: base = view height / pixel rows, slope = 0; perspective:
@@ -52,6 +53,13 @@ RESOCT_FN float resoct_advance_t(float t, float dt) {
   float next = t + dt;
   if (next <= t) next = t + max(abs(t) * RESOCT_T_ULP_FACTOR, RESOCT_LOD_MIN_FOOTPRINT);
   return next;
+}
+
+/// Length of the segment that starts at t: the step, shortened at the exit so that segments tile
+/// [t_enter, t_exit) and the last sample's opacity is corrected for its true length. Sample at
+/// the segment's midpoint; 0 once t >= t_exit.
+RESOCT_FN float resoct_segment_length(float t, float dt, float t_exit) {
+  return max(min(dt, t_exit - t), 0.0f);
 }
 
 /// World size of one pixel at view depth `depth` (distance along the camera's forward axis).
