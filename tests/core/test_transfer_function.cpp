@@ -142,6 +142,35 @@ TEST(TransferFunction, VisibleSetAgreesWithLutBruteForce) {
   EXPECT_TRUE(tf.visible_in(0.3, 0.705));
 }
 
+TEST(TransferFunction, KernelRangeTestIsConservative) {
+  // For random node bounds: whenever the exact interval test says visible, the kernel's
+  // bin-mask test must too; and the kernel test agrees with the host occupancy mask.
+  using namespace resoct::kernel;
+  const TransferFunction tf({{0.1, {1, 0, 0, 0}},
+                             {0.2, {1, 0, 0, 0.5}},
+                             {0.25, {1, 0, 0, 0}},
+                             {0.7, {0, 1, 0, 0}},
+                             {0.71, {0, 1, 0, 1}},
+                             {0.72, {0, 1, 0, 0}}});
+  const resoct::ValueRange unit{0.0, 1.0};
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  for (int i = 0; i < 20000; ++i) {
+    double lo = u(rng), hi = u(rng);
+    if (lo > hi) std::swap(lo, hi);
+    const bool kernel = resoct_tf_range_visible(tf.visible_mask(), float(lo), float(hi));
+    if (tf.visible_in(lo, hi)) {
+      EXPECT_TRUE(kernel) << lo << " " << hi;
+    }
+    EXPECT_EQ(kernel, (tf.visible_mask() & resoct::occupancy_span(lo, hi, unit)) != 0u);
+  }
+  EXPECT_FALSE(resoct_tf_range_visible(~0u, std::nanf(""), 1.0f));
+  EXPECT_FALSE(resoct_tf_range_visible(~0u, 0.6f, 0.5f));
+  EXPECT_EQ(resoct_occupancy_bin(1.0f), 31u);
+  EXPECT_EQ(resoct_occupancy_bin(0.03125f), 1u);
+  EXPECT_EQ(resoct_occupancy_bin(-4.0f), 0u);
+}
+
 TEST(TransferFunction, FullyTransparentAndFullyOpaque) {
   const TransferFunction none({{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0}}});
   EXPECT_TRUE(none.fully_transparent());

@@ -40,6 +40,7 @@ void main() {
 
   float v = resoct_normalize_value(128.0f, 0.0f, 1.0f / 255.0f);
   vec4 c = resoct_tf_lookup(0u, v);
+  if (!resoct_tf_range_visible(0xF0u, 0.1f, v)) c = vec4(resoct_occupancy_bin(v));
   float a = resoct_correct_opacity(c.a, dt * 256.0f);
   vec4 weighted;
   float combined;

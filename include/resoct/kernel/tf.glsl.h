@@ -33,6 +33,25 @@ RESOCT_FN vec4 resoct_tf_lookup(uint slot, float v) {
   return mix(resoct_read_tf(slot, i0), resoct_read_tf(slot, i0 + 1u), f);
 }
 
+/// Occupancy bin of a normalized value: floor(v * 32) clamped to [0, 31], as
+/// resoct::occupancy_bit over [0, 1]. NaN must be filtered by the caller.
+RESOCT_FN uint resoct_occupancy_bin(float v) {
+  return min(uint(clamp(v, 0.0f, 1.0f) * 32.0f), 31u);
+}
+
+/// Whether a node with normalized value bounds [lo, hi] may render visibly under a transfer
+/// function whose visible occupancy mask is `tf_mask` (TransferFunction::visible_mask). It is
+/// conservative: it tests whole bins, so it never culls what TransferFunction::visible_in
+/// accepts. NaN bounds or lo > hi (no finite values) are invisible.
+RESOCT_FN bool resoct_tf_range_visible(uint tf_mask, float lo, float hi) {
+  if (isnan(lo) || isnan(hi) || lo > hi) return false;
+  uint a = resoct_occupancy_bin(lo);
+  uint b = resoct_occupancy_bin(hi);
+  uint upto_b = b >= 31u ? 0xFFFFFFFFu : ((1u << (b + 1u)) - 1u);
+  uint below_a = (1u << a) - 1u;
+  return (tf_mask & upto_b & ~below_a) != 0u;
+}
+
 RESOCT_KERNEL_END
 
 #endif  // RESOCT_KERNEL_TF_GLSL_H
