@@ -33,6 +33,8 @@ RESOCT_KERNEL_BEGIN
 
 /// 2^-23: |t| * this is at least one float ulp of t.
 RESOCT_CONST(float, RESOCT_T_ULP_FACTOR, 1.1920929e-7f);
+/// Smallest advance of t at t = 0 (where the relative ulp bound is 0).
+RESOCT_CONST(float, RESOCT_T_MIN_ADVANCE, 1.0e-30f);
 /// Smallest footprint used for the LOD logarithm, so log2 never sees 0.
 RESOCT_CONST(float, RESOCT_LOD_MIN_FOOTPRINT, 1.0e-30f);
 
@@ -51,7 +53,7 @@ RESOCT_FN float resoct_step_size(vec3 dir, vec3 voxel_size, float step_scale, fl
 /// t + dt, but at least the next float after t, so every loop iteration makes progress.
 RESOCT_FN float resoct_advance_t(float t, float dt) {
   float next = t + dt;
-  if (next <= t) next = t + max(abs(t) * RESOCT_T_ULP_FACTOR, RESOCT_LOD_MIN_FOOTPRINT);
+  if (next <= t) next = t + max(abs(t) * RESOCT_T_ULP_FACTOR, RESOCT_T_MIN_ADVANCE);
   return next;
 }
 
