@@ -127,7 +127,7 @@ TEST(KernelComposite, IntermixingMatchesFormulaAndIsOrderIndependent) {
   std::mt19937 rng(99);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (int trial = 0; trial < 200; ++trial) {
-    std::vector<vec4> s(1 + trial % 6);
+    std::vector<vec4> s(std::size_t(1 + trial % 6));
     for (vec4& x : s) x = vec4(u(rng), u(rng), u(rng), u(rng) * u(rng));
     // Definition: α = 1 − Π(1 − α_c), rgb = α Σ α_c c_c / Σ α_c.
     double transmit = 1.0, wsum = 0.0;
