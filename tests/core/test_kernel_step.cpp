@@ -1,5 +1,6 @@
 // kernel/step.glsl.h compiled as C++: Eq. 8.2-8.3 step size with zero guards, progress of t,
 // and the per-sample LOD level against hand calculations.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -14,6 +15,8 @@ inline float resoct_read_level_size_log2(std::uint32_t level) {
 }
 }  // namespace resoct::kernel
 
+#include "resoct/camera.hpp"
+#include "resoct/hierarchy.hpp"
 #include "resoct/kernel/step.glsl.h"
 
 namespace {
@@ -90,6 +93,37 @@ TEST(KernelLod, HandCalculationPerspective) {
   EXPECT_EQ(resoct_lod_level(resoct_lod_budget_log2(0.0f, slope, 0.25f, 1.0f), 9u), 0u);
   // Far away: capped at the last level.
   EXPECT_EQ(resoct_lod_level(resoct_lod_budget_log2(0.0f, slope, 1e6f, 1.0f), 9u), 8u);
+}
+
+TEST(KernelLod, CameraAndHierarchyTablesGiveTheHandCalculatedLevel) {
+  // 256^3 voxels, 32^3 bricks: levels 0..3 with voxels 1, 2, 4, 8 level-0 voxels wide.
+  resoct::VolumeDesc v;
+  v.extent = {256, 256, 256};
+  const resoct::BrickHierarchy hier(v, resoct::BrickLayout{});
+  ASSERT_EQ(hier.level_count(), 4u);
+  const std::vector<float> table = resoct::level_size_log2_table(hier);
+  std::copy(table.begin(), table.end(), g_level_size_log2.begin());
+  resoct::Camera cam;
+  cam.eye = {0.5, 0.5, 3.0};
+  cam.target = {0.5, 0.5, 0.5};
+  cam.fov_deg = 90.0;
+  const resoct::CameraRays rays(cam, resoct::Viewport{256, 256});
+  // Centre ray; the sample at t = 1.5 has depth 1.5 and a footprint of 1.5/128 = 3 voxels:
+  // level 1 (2 voxels) fits, level 2 (4 voxels) does not.
+  const resoct::Ray r = rays.ray(128.0, 128.0);
+  const float depth = float(1.5 * glm::dot(r.dir, rays.forward()));
+  const float budget = resoct_lod_budget_log2(float(rays.footprint_base()),
+                                              float(rays.footprint_slope()), depth, 1.0f);
+  EXPECT_EQ(resoct_lod_level(budget, hier.level_count()), 1u);
+  // At depth 2.5 (footprint 5 voxels) level 2; with lod_error_px = 2 at depth 1.5, level 2.
+  EXPECT_EQ(
+      resoct_lod_level(resoct_lod_budget_log2(0.0f, float(rays.footprint_slope()), 2.5f, 1.0f),
+                       hier.level_count()),
+      2u);
+  EXPECT_EQ(
+      resoct_lod_level(resoct_lod_budget_log2(0.0f, float(rays.footprint_slope()), 1.5f, 2.0f),
+                       hier.level_count()),
+      2u);
 }
 
 TEST(KernelLod, OrthographicIsIndependentOfDepth) {
