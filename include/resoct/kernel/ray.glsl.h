@@ -1,0 +1,84 @@
+// resoct kernel: ray/box entry and exit, robust for axis-parallel rays, and node-local coordinates.
+//
+// Convention: boxes are HALF-OPEN, [lo, hi) per axis, like voxels, bricks and octree nodes, so
+// every point belongs to exactly one cell. A ray whose direction component along an axis is zero
+// (or |d| < RESOCT_RAY_PARALLEL_EPS, which also covers -0.0 and denormals flushed to zero) never
+// crosses that axis' slabs: it is inside for all t when lo <= origin < hi and misses otherwise.
+// Such components are never divided, so no 0/0 or 0*inf NaN can appear. A ray lying exactly on
+// the lower face of a box is inside it; one lying on the upper face is outside (it belongs to the
+// neighbour). The result is vec2(t_enter, t_exit); the ray hits iff t_enter < t_exit, and the
+// samples it owns are t_enter <= t < t_exit. Rays that only touch an edge or corner get an empty
+// interval. Unbounded ends are +-RESOCT_RAY_T_INF (a finite float, since GLSL has no literal
+// for infinity); callers clamp t_enter to their own t_min (e.g. 0 for the camera origin).
+//
+// Precision for huge volumes (an axis of 2^20 voxels): a float holds a normalized position only
+// to about 2^-24, i.e. a sixteenth of a voxel there, and a float level-0 voxel coordinate near
+// 2^20 only to 1/8 voxel. Callers therefore never intersect nodes in global float coordinates.
+// They keep the ray position as an integer level-0 voxel (ivec3, exact) plus a float fraction,
+// subtract the node's integer lower corner in integers (resoct_relative_origin), and intersect in
+// node-local coordinates where the box is [0, node_size). The float error is then relative to the
+// distance between the sample and the node, not to the volume size.
+#ifndef RESOCT_KERNEL_RAY_GLSL_H
+#define RESOCT_KERNEL_RAY_GLSL_H
+
+#include "resoct/kernel/common.glsl.h"
+
+RESOCT_KERNEL_BEGIN
+
+/// Stand-in for infinity in ray parameters (largest useful float order of magnitude).
+RESOCT_CONST(float, RESOCT_RAY_T_INF, 3.0e38f);
+/// Direction components smaller than this in magnitude count as parallel to the slab. A ray of
+/// unit length with such a component would need t > 1e20 to cross a unit slab.
+RESOCT_CONST(float, RESOCT_RAY_PARALLEL_EPS, 1.0e-20f);
+
+/// Slab interval of one axis: (t at which the ray enters, t at which it leaves) [lo, hi).
+RESOCT_FN vec2 resoct_ray_slab(float origin, float dir, float lo, float hi) {
+  if (abs(dir) < RESOCT_RAY_PARALLEL_EPS) {
+    // Parallel: inside for all t or never. Half-open: the lower face belongs to the box.
+    if (origin >= lo && origin < hi) return vec2(-RESOCT_RAY_T_INF, RESOCT_RAY_T_INF);
+    return vec2(RESOCT_RAY_T_INF, -RESOCT_RAY_T_INF);
+  }
+  float t0 = (lo - origin) / dir;
+  float t1 = (hi - origin) / dir;
+  return vec2(min(t0, t1), max(t0, t1));
+}
+
+/// Entry and exit parameters of the ray origin + t * dir with the half-open box [lo, hi).
+/// Hit iff result.x < result.y. Never NaN for finite inputs.
+RESOCT_FN vec2 resoct_ray_box(vec3 origin, vec3 dir, vec3 lo, vec3 hi) {
+  vec2 sx = resoct_ray_slab(origin.x, dir.x, lo.x, hi.x);
+  vec2 sy = resoct_ray_slab(origin.y, dir.y, lo.y, hi.y);
+  vec2 sz = resoct_ray_slab(origin.z, dir.z, lo.z, hi.z);
+  return vec2(max(sx.x, max(sy.x, sz.x)), min(sx.y, min(sy.y, sz.y)));
+}
+
+/// True when an interval from resoct_ray_box is non-empty after clamping its start to t_min.
+RESOCT_FN bool resoct_ray_hits(vec2 interval, float t_min) {
+  return max(interval.x, t_min) < interval.y;
+}
+
+/// Ray origin relative to a node's lower corner, in level-0 voxels. The origin is given split
+/// into an exact integer voxel `origin_cell` and a fraction `origin_frac` (any float, normally in
+/// [0, 1)); the integer subtraction is exact for any volume below 2^31 voxels per axis.
+RESOCT_FN vec3 resoct_relative_origin(ivec3 origin_cell, vec3 origin_frac, ivec3 node_lo) {
+  return vec3(origin_cell - node_lo) + origin_frac;
+}
+
+/// Entry and exit with a node in node-local coordinates: the node is [0, node_size) and the
+/// origin is relative to its lower corner (see resoct_relative_origin). t is in the units of
+/// `dir`; use a direction in level-0 voxels per unit t so that t matches the caller's ray.
+RESOCT_FN vec2 resoct_ray_node_local(vec3 origin_rel, vec3 dir, vec3 node_size) {
+  return resoct_ray_box(origin_rel, dir, vec3(0.0f), node_size);
+}
+
+/// Moves the integer/fraction split so that the fraction is in [0, 1) again, keeping
+/// cell + frac unchanged up to float rounding of the fraction.
+RESOCT_FN void resoct_split_normalize(RESOCT_INOUT(ivec3) cell, RESOCT_INOUT(vec3) frac) {
+  vec3 whole = floor(frac);
+  cell = cell + ivec3(whole);
+  frac = frac - whole;
+}
+
+RESOCT_KERNEL_END
+
+#endif  // RESOCT_KERNEL_RAY_GLSL_H

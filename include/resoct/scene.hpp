@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// What to render: camera, viewport, visible channels with transfer functions and level
+/// ranges, sampling and LOD parameters, background and requested effects. Loaded from and saved
+/// to JSON (docs/scene.md).
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "resoct/camera.hpp"
+#include "resoct/transfer_function.hpp"
+#include "resoct/volume_desc.hpp"
+
+namespace resoct {
+
+/// Optional rendering effects a scene may request (DESIGN.md §6).
+enum class Effect : std::uint8_t { shading, shadows };
+/// "shading" / "shadows".
+const char* to_string(Effect e) noexcept;
+
+/// Highest level index a scene may name (the brick key holds 5 bits of level).
+inline constexpr std::uint32_t kMaxSceneLevel = 31;
+
+/// One visible channel.
+struct ChannelSettings {
+  std::uint32_t channel = 0;  ///< dataset channel, < kMaxChannels
+  TransferFunction tf;
+  std::uint32_t finest_level = 0;     ///< finest level this channel may render, <= coarsest
+  std::uint32_t coarsest_level = 15;  ///< coarsest; clamped to the dataset's last level
+  /// Request priority among channels; lower loads first. Ties keep the channel order.
+  std::int32_t importance = 0;
+  friend bool operator==(const ChannelSettings&, const ChannelSettings&) = default;
+};
+
+/// A plain value type; copy freely. Not synchronised: do not modify while another thread reads.
+struct Scene {
+  Camera camera;
+  Viewport viewport;
+  std::vector<ChannelSettings> channels;
+  double step_scale = 1.0;    ///< step as a multiple of Eq. 8.2-8.3's one-voxel step, > 0
+  double lod_error_px = 1.0;  ///< allowed projected voxel size in pixels, > 0
+  double ert_opacity = 0.99;  ///< early termination opacity, in (0, 1]
+  glm::dvec4 background{0.0, 0.0, 0.0, 1.0};  ///< straight-alpha RGBA, each in [0, 1]
+  std::vector<Effect> effects;
+
+  /// Throws Error(invalid_argument) "<what>: <field>: why" when a field is out of range (the
+  /// same checks as loading), `what` e.g. a file name.
+  void validate(const std::string& what = "scene") const;
+  /// validate(), plus every channel must exist in `volume`.
+  void validate(const VolumeDesc& volume, const std::string& what = "scene") const;
+
+  friend bool operator==(const Scene&, const Scene&) = default;
+};
+
+/// Parses a scene from JSON text. `name` prefixes error messages. Malformed JSON throws
+/// Error(corrupt) "<name>: offset <n>: ..."; a missing, mistyped, unknown or out-of-range field
+/// throws Error(invalid_argument) "<name>: <json path>: why", e.g.
+/// "scene.json: channels[2].tf[1]: value 1.3 outside [0,1]".
+Scene parse_scene(std::string_view json_text, const std::string& name = "scene");
+/// Reads and parses a file; Error(io) naming the path when it cannot be read.
+Scene load_scene(const std::string& path);
+/// The JSON text of a scene (every field written; parse_scene(scene_to_json(s)) == s).
+std::string scene_to_json(const Scene& scene);
+/// Writes scene_to_json atomically (temporary file in the same directory, then rename);
+/// Error(io) naming the path on failure, leaving no file behind.
+void save_scene(const Scene& scene, const std::string& path);
+
+}  // namespace resoct

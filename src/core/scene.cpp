@@ -1,0 +1,379 @@
+#include "resoct/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "atomic_write.hpp"
+#include "resoct/error.hpp"
+
+namespace resoct {
+namespace {
+
+using nlohmann::json;
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Builds "<name>: <path>: why" errors while walking the JSON document.
+class Reader {
+ public:
+  explicit Reader(std::string name) : name_(std::move(name)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& why) const {
+    throw Error(ErrorCode::invalid_argument, name_ + ": " + path + ": " + why);
+  }
+
+  // Unknown keys are rejected rather than ignored: a misspelt "ert_opacty" would otherwise
+  // silently render with the default.
+  void only_keys(const json& obj, const std::string& path,
+                 std::initializer_list<const char*> keys) const {
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+      bool known = false;
+      for (const char* k : keys) known = known || it.key() == k;
+      if (!known) fail(join(path, it.key()), "unknown key");
+    }
+  }
+
+  const json& object(const json& j, const std::string& path) const {
+    if (!j.is_object()) fail(path, "must be an object");
+    return j;
+  }
+  const json& array(const json& j, const std::string& path) const {
+    if (!j.is_array()) fail(path, "must be an array");
+    return j;
+  }
+  const json* find(const json& obj, const char* key) const {
+    const auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+  const json& require(const json& obj, const std::string& path, const char* key) const {
+    const json* j = find(obj, key);
+    if (j == nullptr) fail(join(path, key), "missing");
+    return *j;
+  }
+  double number(const json& j, const std::string& path) const {
+    if (!j.is_number()) fail(path, "must be a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(path, "must be finite");
+    return v;
+  }
+  std::int64_t integer(const json& j, const std::string& path) const {
+    if (!j.is_number_integer()) fail(path, "must be an integer");
+    if (j.is_number_unsigned() && j.get<std::uint64_t>() > std::uint64_t(INT64_MAX)) {
+      fail(path, "out of range");
+    }
+    return j.get<std::int64_t>();
+  }
+  std::string string(const json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, "must be a string");
+    return j.get<std::string>();
+  }
+  template <int N>
+  glm::vec<N, double> vector(const json& j, const std::string& path) const {
+    array(j, path);
+    if (j.size() != std::size_t(N)) fail(path, "must have " + std::to_string(N) + " numbers");
+    glm::vec<N, double> v{};
+    for (int i = 0; i < N; ++i) v[i] = number(j[std::size_t(i)], index(path, std::size_t(i)));
+    return v;
+  }
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  static std::string index(const std::string& path, std::size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+  }
+  const std::string& name() const noexcept { return name_; }
+
+ private:
+  std::string name_;
+};
+
+Camera read_camera(const Reader& r, const json& j) {
+  const std::string path = "camera";
+  r.object(j, path);
+  r.only_keys(j, path, {"eye", "target", "up", "fov_deg", "ortho_height", "projection"});
+  Camera c;
+  c.eye = r.vector<3>(r.require(j, path, "eye"), "camera.eye");
+  c.target = r.vector<3>(r.require(j, path, "target"), "camera.target");
+  if (const json* up = r.find(j, "up")) c.up = r.vector<3>(*up, "camera.up");
+  if (const json* fov = r.find(j, "fov_deg")) c.fov_deg = r.number(*fov, "camera.fov_deg");
+  if (const json* h = r.find(j, "ortho_height")) {
+    c.ortho_height = r.number(*h, "camera.ortho_height");
+  }
+  if (const json* p = r.find(j, "projection")) {
+    const std::string s = r.string(*p, "camera.projection");
+    if (s == "perspective") {
+      c.projection = Projection::perspective;
+    } else if (s == "orthographic") {
+      c.projection = Projection::orthographic;
+    } else {
+      r.fail("camera.projection", "'" + s + "' is not \"perspective\" or \"orthographic\"");
+    }
+  }
+  return c;
+}
+
+Viewport read_viewport(const Reader& r, const json& j) {
+  r.object(j, "viewport");
+  r.only_keys(j, "viewport", {"width", "height"});
+  Viewport v;
+  const std::int64_t w = r.integer(r.require(j, "viewport", "width"), "viewport.width");
+  const std::int64_t h = r.integer(r.require(j, "viewport", "height"), "viewport.height");
+  if (w < 1 || w > 16384) r.fail("viewport.width", "must be in 1..16384");
+  if (h < 1 || h > 16384) r.fail("viewport.height", "must be in 1..16384");
+  v.width = std::uint32_t(w);
+  v.height = std::uint32_t(h);
+  return v;
+}
+
+TransferFunction read_tf(const Reader& r, const json& j, const std::string& path) {
+  r.array(j, path);
+  std::vector<TfPoint> points;
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const std::string p = Reader::index(path, i);
+    r.array(j[i], p);
+    if (j[i].size() != 5) r.fail(p, "must be [value, r, g, b, alpha]");
+    TfPoint point;
+    point.value = r.number(j[i][0], p);
+    for (int c = 0; c < 4; ++c) point.rgba[c] = r.number(j[i][std::size_t(c) + 1], p);
+    points.push_back(point);
+  }
+  validate_tf_points(points, r.name() + ": " + path);
+  return TransferFunction(std::move(points));
+}
+
+ChannelSettings read_channel(const Reader& r, const json& j, const std::string& path) {
+  r.object(j, path);
+  r.only_keys(j, path, {"channel", "tf", "levels", "importance", "mode"});
+  ChannelSettings c;
+  const std::string channel_path = Reader::join(path, "channel");
+  const std::int64_t channel = r.integer(r.require(j, path, "channel"), channel_path);
+  if (channel < 0 || channel >= std::int64_t(kMaxChannels)) {
+    r.fail(channel_path, "must be in 0.." + std::to_string(kMaxChannels - 1));
+  }
+  c.channel = std::uint32_t(channel);
+  c.tf = read_tf(r, r.require(j, path, "tf"), Reader::join(path, "tf"));
+  if (const json* levels = r.find(j, "levels")) {
+    const std::string lp = Reader::join(path, "levels");
+    r.array(*levels, lp);
+    if (levels->size() != 2) r.fail(lp, "must be [finest, coarsest]");
+    const std::int64_t a = r.integer((*levels)[0], Reader::index(lp, 0));
+    const std::int64_t b = r.integer((*levels)[1], Reader::index(lp, 1));
+    if (a < 0 || a > kMaxSceneLevel || b < 0 || b > kMaxSceneLevel) {
+      r.fail(lp, "levels must be in 0.." + std::to_string(kMaxSceneLevel));
+    }
+    c.finest_level = std::uint32_t(a);
+    c.coarsest_level = std::uint32_t(b);
+  }
+  if (const json* imp = r.find(j, "importance")) {
+    const std::string ip = Reader::join(path, "importance");
+    const std::int64_t v = r.integer(*imp, ip);
+    if (v < INT32_MIN || v > INT32_MAX) r.fail(ip, "out of range");
+    c.importance = std::int32_t(v);
+  }
+  if (const json* mode = r.find(j, "mode")) {
+    const std::string mp = Reader::join(path, "mode");
+    const std::string m = r.string(*mode, mp);
+    if (m != "dvr") r.fail(mp, "'" + m + "' is not a supported mode (\"dvr\")");
+  }
+  return c;
+}
+
+void check_scene(const Scene& s, const std::string& what) {
+  auto fail = [&](const std::string& path, const std::string& why) {
+    throw Error(ErrorCode::invalid_argument, what + ": " + path + ": " + why);
+  };
+  const Camera& cam = s.camera;
+  const auto finite3 = [](const glm::dvec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+  };
+  if (!finite3(cam.eye)) fail("camera.eye", "must be finite");
+  if (!finite3(cam.target)) fail("camera.target", "must be finite");
+  if (!finite3(cam.up)) fail("camera.up", "must be finite");
+  if (!(cam.fov_deg > 0.0 && cam.fov_deg < 180.0)) {
+    fail("camera.fov_deg", fmt(cam.fov_deg) + " outside (0, 180)");
+  }
+  if (!(cam.ortho_height > 0.0) || !std::isfinite(cam.ortho_height)) {
+    fail("camera.ortho_height", "must be a positive finite number");
+  }
+  if (s.viewport.width < 1 || s.viewport.width > 16384) {
+    fail("viewport.width", "must be in 1..16384");
+  }
+  if (s.viewport.height < 1 || s.viewport.height > 16384) {
+    fail("viewport.height", "must be in 1..16384");
+  }
+  // The remaining camera conditions (eye != target, up not parallel) are CameraRays' own.
+  try {
+    CameraRays(cam, s.viewport);
+  } catch (const Error& e) {
+    fail("camera", e.what());
+  }
+  if (s.channels.empty()) fail("channels", "must list at least one channel");
+  for (std::size_t i = 0; i < s.channels.size(); ++i) {
+    const ChannelSettings& c = s.channels[i];
+    const std::string p = "channels[" + std::to_string(i) + "]";
+    if (c.channel >= kMaxChannels) fail(p + ".channel", "out of range");
+    for (std::size_t k = 0; k < i; ++k) {
+      if (s.channels[k].channel == c.channel) {
+        fail(p + ".channel", "channel " + std::to_string(c.channel) + " is listed twice");
+      }
+    }
+    if (c.coarsest_level > kMaxSceneLevel) fail(p + ".levels", "coarsest level out of range");
+    if (c.finest_level > c.coarsest_level) {
+      fail(p + ".levels", "finest " + std::to_string(c.finest_level) + " above coarsest " +
+                              std::to_string(c.coarsest_level));
+    }
+  }
+  if (!(s.step_scale >= 1e-6 && s.step_scale <= 1000.0)) {
+    fail("step_scale", fmt(s.step_scale) + " outside [1e-6, 1000]");
+  }
+  if (!(s.lod_error_px > 0.0 && s.lod_error_px <= 1e6)) {
+    fail("lod_error_px", fmt(s.lod_error_px) + " outside (0, 1e6]");
+  }
+  if (!(s.ert_opacity > 0.0 && s.ert_opacity <= 1.0)) {
+    fail("ert_opacity", fmt(s.ert_opacity) + " outside (0, 1]");
+  }
+  for (int c = 0; c < 4; ++c) {
+    if (!(s.background[c] >= 0.0 && s.background[c] <= 1.0)) {
+      fail("background[" + std::to_string(c) + "]", fmt(s.background[c]) + " outside [0,1]");
+    }
+  }
+  for (std::size_t i = 0; i < s.effects.size(); ++i) {
+    for (std::size_t k = 0; k < i; ++k) {
+      if (s.effects[k] == s.effects[i]) {
+        fail("effects[" + std::to_string(i) + "]",
+             std::string("'") + to_string(s.effects[i]) + "' is listed twice");
+      }
+    }
+  }
+}
+
+json vec_json(const double* v, int n) {
+  json a = json::array();
+  for (int i = 0; i < n; ++i) a.push_back(v[i]);
+  return a;
+}
+
+}  // namespace
+
+const char* to_string(Effect e) noexcept {
+  return e == Effect::shadows ? "shadows" : "shading";
+}
+
+void Scene::validate(const std::string& what) const {
+  check_scene(*this, what);
+}
+
+void Scene::validate(const VolumeDesc& volume, const std::string& what) const {
+  check_scene(*this, what);
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    if (channels[i].channel >= volume.channels) {
+      throw Error(ErrorCode::invalid_argument,
+                  what + ": channels[" + std::to_string(i) + "].channel: channel " +
+                      std::to_string(channels[i].channel) + " not in the volume's " +
+                      std::to_string(volume.channels) + " channels");
+    }
+  }
+}
+
+Scene parse_scene(std::string_view json_text, const std::string& name) {
+  json doc;
+  try {
+    doc = json::parse(json_text.begin(), json_text.end());
+  } catch (const json::parse_error& e) {
+    throw file_error(ErrorCode::corrupt, name, e.byte, std::string("malformed JSON: ") + e.what());
+  }
+  const Reader r(name);
+  if (!doc.is_object()) r.fail("(root)", "must be an object");
+  r.only_keys(doc, "",
+              {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity",
+               "background", "effects"});
+  Scene s;
+  s.camera = read_camera(r, r.require(doc, "", "camera"));
+  if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
+  const json& channels = r.array(r.require(doc, "", "channels"), "channels");
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    s.channels.push_back(read_channel(r, channels[i], Reader::index("channels", i)));
+  }
+  if (const json* v = r.find(doc, "step_scale")) s.step_scale = r.number(*v, "step_scale");
+  if (const json* v = r.find(doc, "lod_error_px")) s.lod_error_px = r.number(*v, "lod_error_px");
+  if (const json* v = r.find(doc, "ert_opacity")) s.ert_opacity = r.number(*v, "ert_opacity");
+  if (const json* v = r.find(doc, "background")) s.background = r.vector<4>(*v, "background");
+  if (const json* v = r.find(doc, "effects")) {
+    r.array(*v, "effects");
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      const std::string p = Reader::index("effects", i);
+      const std::string e = r.string((*v)[i], p);
+      if (e == "shading") {
+        s.effects.push_back(Effect::shading);
+      } else if (e == "shadows") {
+        s.effects.push_back(Effect::shadows);
+      } else {
+        r.fail(p, "unknown effect '" + e + "' (known: \"shading\", \"shadows\")");
+      }
+    }
+  }
+  check_scene(s, name);
+  return s;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ErrorCode::io, path + ": cannot open for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(ErrorCode::io, path + ": read failed");
+  return parse_scene(text.str(), path);
+}
+
+std::string scene_to_json(const Scene& s) {
+  json doc;
+  json cam;
+  cam["eye"] = vec_json(&s.camera.eye.x, 3);
+  cam["target"] = vec_json(&s.camera.target.x, 3);
+  cam["up"] = vec_json(&s.camera.up.x, 3);
+  cam["fov_deg"] = s.camera.fov_deg;
+  cam["ortho_height"] = s.camera.ortho_height;
+  cam["projection"] = to_string(s.camera.projection);
+  doc["camera"] = cam;
+  doc["viewport"] = {{"width", s.viewport.width}, {"height", s.viewport.height}};
+  json channels = json::array();
+  for (const ChannelSettings& c : s.channels) {
+    json tf = json::array();
+    for (const TfPoint& p : c.tf.points()) {
+      tf.push_back({p.value, p.rgba.r, p.rgba.g, p.rgba.b, p.rgba.a});
+    }
+    channels.push_back({{"channel", c.channel},
+                        {"tf", tf},
+                        {"levels", {c.finest_level, c.coarsest_level}},
+                        {"importance", c.importance},
+                        {"mode", "dvr"}});
+  }
+  doc["channels"] = channels;
+  doc["step_scale"] = s.step_scale;
+  doc["lod_error_px"] = s.lod_error_px;
+  doc["ert_opacity"] = s.ert_opacity;
+  doc["background"] = vec_json(&s.background.x, 4);
+  json effects = json::array();
+  for (Effect e : s.effects) effects.push_back(to_string(e));
+  doc["effects"] = effects;
+  return doc.dump(2) + "\n";
+}
+
+void save_scene(const Scene& scene, const std::string& path) {
+  scene.validate(path);
+  const std::string text = scene_to_json(scene);
+  detail::write_file_atomically(path, [&](std::FILE* f) {
+    return std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  });
+}
+
+}  // namespace resoct
