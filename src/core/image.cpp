@@ -7,7 +7,7 @@
 
 #include <png.h>
 
-#include "atomic_write.hpp"
+#include "resoct/file_io.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct {
@@ -50,19 +50,31 @@ Image Image::from_rgba8(std::uint32_t width, std::uint32_t height,
 void write_png(const Image& image, const std::string& path) {
   if (image.width() == 0) throw invalid_parameter("image", "is empty");
   const std::vector<std::uint8_t> rgba = image.to_rgba8();
-  std::string message;
-  detail::write_file_atomically(path, [&](std::FILE* f) {
-    png_image png;
-    std::memset(&png, 0, sizeof png);
-    png.version = PNG_IMAGE_VERSION;
-    png.width = image.width();
-    png.height = image.height();
-    png.format = PNG_FORMAT_RGBA;
-    const int ok = png_image_write_to_stdio(&png, f, 0, rgba.data(), 0, nullptr);
-    if (!ok) message = png.message;
+  // Encode in memory first: a PNG error then leaves nothing behind, and the file is written
+  // through the same atomic writer as every other output.
+  png_image png;
+  std::memset(&png, 0, sizeof png);
+  png.version = PNG_IMAGE_VERSION;
+  png.width = image.width();
+  png.height = image.height();
+  png.format = PNG_FORMAT_RGBA;
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, rgba.data(), 0, nullptr)) {
+    const std::string msg = png.message;
     png_image_free(&png);
-    return ok != 0;
-  });
+    throw Error(ErrorCode::io, path + ": PNG encoding failed: " + msg);
+  }
+  std::vector<std::byte> encoded(size);
+  if (!png_image_write_to_memory(&png, encoded.data(), &size, 0, rgba.data(), 0, nullptr)) {
+    const std::string msg = png.message;
+    png_image_free(&png);
+    throw Error(ErrorCode::io, path + ": PNG encoding failed: " + msg);
+  }
+  png_image_free(&png);
+  encoded.resize(size);
+  AtomicFileWriter out(path);
+  out.append(encoded);
+  out.commit();
 }
 
 Image read_png(const std::string& path) {

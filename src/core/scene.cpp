@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "atomic_write.hpp"
+#include "resoct/file_io.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct {
@@ -371,9 +371,9 @@ std::string scene_to_json(const Scene& s) {
 void save_scene(const Scene& scene, const std::string& path) {
   scene.validate(path);
   const std::string text = scene_to_json(scene);
-  detail::write_file_atomically(path, [&](std::FILE* f) {
-    return std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  });
+  AtomicFileWriter out(path);
+  out.append(std::as_bytes(std::span(text.data(), text.size())));
+  out.commit();
 }
 
 }  // namespace resoct
