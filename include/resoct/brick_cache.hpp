@@ -9,7 +9,6 @@
 #include <memory>
 #include <optional>
 #include <span>
-#include <unordered_map>
 #include <vector>
 
 #include "resoct/brick_key.hpp"
@@ -18,6 +17,28 @@
 #include "resoct/voxel_type.hpp"
 
 namespace resoct {
+
+namespace detail {
+/// BrickKey bits -> cache slot: open addressing with linear probing and backward-shift deletion,
+/// load factor <= 1/2, so lookups, inserts and erases are O(1) expected without allocation.
+class KeySlotIndex {
+ public:
+  static constexpr std::uint64_t kEmpty = std::numeric_limits<std::uint64_t>::max();
+  void reset(std::uint32_t max_entries);
+  std::optional<std::uint32_t> find(std::uint64_t key) const noexcept;
+  void insert(std::uint64_t key, std::uint32_t slot) noexcept;  ///< key must be absent
+  void erase(std::uint64_t key) noexcept;                       ///< no-op when absent
+
+ private:
+  struct Cell {
+    std::uint64_t key = kEmpty;
+    std::uint32_t slot = 0;
+  };
+  std::size_t home(std::uint64_t key) const noexcept;
+  std::vector<Cell> cells_;
+  std::size_t mask_ = 0;
+};
+}  // namespace detail
 
 /// A slot given to a new brick, and the brick that was evicted to make room (its page-table entry
 /// must become UNMAPPED and the residency octree must drop it).
@@ -46,7 +67,7 @@ class BrickCache {
   BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t capacity_bytes,
              std::uint32_t ttl = 2, std::unique_ptr<EvictionPolicy> policy = nullptr);
 
-  std::uint32_t slot_count() const noexcept { return std::uint32_t(keys_.size()); }
+  std::uint32_t slot_count() const noexcept { return std::uint32_t(slots_.size()); }
   std::uint64_t slot_bytes() const noexcept { return slot_bytes_; }
   VoxelType voxel_type() const noexcept { return type_; }
   std::uint32_t ttl() const noexcept { return ttl_; }
@@ -75,7 +96,7 @@ class BrickCache {
 
  private:
   void check_resident(std::uint32_t slot) const;
-  PinState pins() const noexcept { return {last_use_.data(), uploaded_.data(), frame_, ttl_}; }
+  PinState pins() const noexcept { return {slots_.data(), frame_, ttl_}; }
 
   static constexpr std::uint64_t kFreeKey = std::numeric_limits<std::uint64_t>::max();
   std::uint64_t slot_bytes_ = 0;
@@ -85,11 +106,9 @@ class BrickCache {
   std::uint64_t frame_ = 0;  // before the first begin_frame(), uses count as frame 0
   bool started_ = false;
   std::uint32_t resident_ = 0;
-  std::vector<std::uint64_t> keys_;  // BrickKey bits or kFreeKey
-  std::vector<std::uint64_t> last_use_;
-  std::vector<std::uint64_t> uploaded_;
+  std::vector<CacheSlot> slots_;     // key_bits == kFreeKey: free
   std::vector<std::uint32_t> free_;  // stack of free slots
-  std::unordered_map<std::uint64_t, std::uint32_t> index_;
+  detail::KeySlotIndex index_;
   BrickCacheStats stats_;
 };
 

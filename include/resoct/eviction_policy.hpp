@@ -13,15 +13,22 @@
 
 namespace resoct {
 
+/// The cache's record of one slot, 32 bytes so that a touch reads one cache line.
+struct alignas(32) CacheSlot {
+  std::uint64_t key_bits = 0;  ///< BrickKey bits, or all ones when the slot is free
+  std::uint64_t last_use = 0;  ///< frame of the last use
+  std::uint64_t uploaded = 0;  ///< frame of the upload
+};
+
 /// The cache's pinning rule, handed to policies: a slot is pinned while it was used in the
 /// current frame or was uploaded fewer than `ttl` frames ago (frame < uploaded + ttl).
 struct PinState {
-  const std::uint64_t* last_use = nullptr;  ///< per slot
-  const std::uint64_t* uploaded = nullptr;  ///< per slot
+  const CacheSlot* slots = nullptr;
   std::uint64_t frame = 0;
   std::uint32_t ttl = 0;
+  std::uint64_t last_use(std::uint32_t slot) const noexcept { return slots[slot].last_use; }
   bool pinned(std::uint32_t slot) const noexcept {
-    return last_use[slot] == frame || frame < uploaded[slot] + ttl;
+    return slots[slot].last_use == frame || frame < slots[slot].uploaded + ttl;
   }
 };
 
@@ -62,7 +69,10 @@ class LruPolicy final : public EvictionPolicy {
   void append(std::uint32_t slot);
 
   static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
-  std::vector<std::uint32_t> prev_, next_;
+  struct Link {
+    std::uint32_t prev = kNone, next = kNone;
+  };
+  std::vector<Link> links_;
   std::uint32_t head_ = kNone, tail_ = kNone;
   std::uint32_t cursor_ = kNone;  // first slot not yet known to be pinned in this frame
 };
@@ -106,6 +116,10 @@ class OctreemizerPolicy final : public EvictionPolicy {
   double priority(std::uint32_t slot, std::uint64_t frame) const;
 
  private:
+  struct HeapItem {
+    double rank;  // q of the slot, cached so that sifting reads only the heap array
+    std::uint32_t slot;
+  };
   struct Entry {
     BrickKey key;
     std::uint64_t last_use = 0;
@@ -117,7 +131,7 @@ class OctreemizerPolicy final : public EvictionPolicy {
   void heap_fix(std::uint32_t slot);
   void sift_up(std::size_t i);
   void sift_down(std::size_t i);
-  void place(std::size_t i, std::uint32_t slot);
+  void place(std::size_t i, const HeapItem& item);
 
   static constexpr std::uint32_t kAbsent = 0xFFFFFFFFu;
   static constexpr std::uint32_t kParked = 0xFFFFFFFEu;
@@ -126,7 +140,7 @@ class OctreemizerPolicy final : public EvictionPolicy {
   DistanceFn distance_fn_;
   std::vector<Entry> entries_;
   std::vector<std::uint32_t> pos_;  // heap position, kAbsent (free) or kParked
-  std::vector<std::uint32_t> heap_;
+  std::vector<HeapItem> heap_;
   std::vector<std::uint32_t> parked_;
 };
 

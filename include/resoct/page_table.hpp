@@ -96,7 +96,16 @@ class PageTable {
   void store(std::uint32_t index, std::uint32_t value);
   void check_slot(std::uint32_t slot) const;
 
+  // Per-level constants of translate(): level voxels per unit of p (extent0 / 2^f, exact because
+  // the divisor is a power of two, so p * scale equals level_voxel_position), last voxel, bricks.
+  struct LevelScale {
+    glm::dvec3 scale{1.0};
+    glm::dvec3 last_voxel{0.0};
+    glm::uvec3 bricks{1};
+  };
+
   BrickHierarchy hierarchy_;
+  std::vector<LevelScale> scales_;
   std::uint32_t slots_ = 0;
   std::uint32_t levels_ = 0;
   std::vector<std::uint32_t> entries_;

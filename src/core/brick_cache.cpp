@@ -7,6 +7,52 @@
 
 namespace resoct {
 
+namespace detail {
+
+void KeySlotIndex::reset(std::uint32_t max_entries) {
+  std::size_t n = 2;
+  while (n < 2 * std::size_t(max_entries)) n *= 2;
+  cells_.assign(n, Cell{});
+  mask_ = n - 1;
+}
+
+std::size_t KeySlotIndex::home(std::uint64_t key) const noexcept {
+  return std::hash<BrickKey>{}(BrickKey::from_bits(key)) & mask_;
+}
+
+std::optional<std::uint32_t> KeySlotIndex::find(std::uint64_t key) const noexcept {
+  for (std::size_t i = home(key);; i = (i + 1) & mask_) {
+    if (cells_[i].key == key) return cells_[i].slot;
+    if (cells_[i].key == kEmpty) return std::nullopt;
+  }
+}
+
+void KeySlotIndex::insert(std::uint64_t key, std::uint32_t slot) noexcept {
+  std::size_t i = home(key);
+  while (cells_[i].key != kEmpty) i = (i + 1) & mask_;
+  cells_[i] = Cell{key, slot};
+}
+
+void KeySlotIndex::erase(std::uint64_t key) noexcept {
+  std::size_t i = home(key);
+  while (cells_[i].key != key) {
+    if (cells_[i].key == kEmpty) return;
+    i = (i + 1) & mask_;
+  }
+  // Backward shift: pull later members of the probe run into the hole so that no tombstones are
+  // needed and probe runs stay short.
+  for (std::size_t j = (i + 1) & mask_; cells_[j].key != kEmpty; j = (j + 1) & mask_) {
+    const std::size_t h = home(cells_[j].key);
+    if (((j - h) & mask_) >= ((j - i) & mask_)) {
+      cells_[i] = cells_[j];
+      i = j;
+    }
+  }
+  cells_[i] = Cell{};
+}
+
+}  // namespace detail
+
 BrickCache::BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t capacity_bytes,
                        std::uint32_t ttl, std::unique_ptr<EvictionPolicy> policy)
     : type_(type), ttl_(ttl), policy_(std::move(policy)) {
@@ -25,13 +71,11 @@ BrickCache::BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t 
   }
   if (!policy_) policy_ = std::make_unique<LruPolicy>();
   const auto n = std::uint32_t(slots);
-  keys_.assign(n, kFreeKey);
-  last_use_.assign(n, 0);
-  uploaded_.assign(n, 0);
+  slots_.assign(n, CacheSlot{kFreeKey, 0, 0});
   free_.resize(n);
   // Lowest slot first: free_ is a stack.
   for (std::uint32_t i = 0; i < n; ++i) free_[i] = n - 1u - i;
-  index_.reserve(n);
+  index_.reset(n);
   policy_->reset(n);
   policy_->begin_frame(frame_);
 }
@@ -47,18 +91,16 @@ void BrickCache::begin_frame(std::uint64_t frame) {
 }
 
 std::optional<std::uint32_t> BrickCache::find(BrickKey key) const {
-  const auto it = index_.find(key.bits());
-  if (it == index_.end()) return std::nullopt;
-  return it->second;
+  return index_.find(key.bits());
 }
 
 std::optional<BrickKey> BrickCache::key_of(std::uint32_t slot) const {
-  if (slot >= keys_.size() || keys_[slot] == kFreeKey) return std::nullopt;
-  return BrickKey::from_bits(keys_[slot]);
+  if (slot >= slots_.size() || slots_[slot].key_bits == kFreeKey) return std::nullopt;
+  return BrickKey::from_bits(slots_[slot].key_bits);
 }
 
 void BrickCache::check_resident(std::uint32_t slot) const {
-  if (slot >= keys_.size() || keys_[slot] == kFreeKey) {
+  if (slot >= slots_.size() || slots_[slot].key_bits == kFreeKey) {
     throw Error(ErrorCode::out_of_range, "cache slot " + std::to_string(slot) + " is not resident");
   }
 }
@@ -70,8 +112,9 @@ bool BrickCache::pinned(std::uint32_t slot) const {
 
 void BrickCache::touch(std::uint32_t slot) {
   check_resident(slot);
-  if (last_use_[slot] == frame_) return;  // already at the MRU end for this frame
-  last_use_[slot] = frame_;
+  CacheSlot& s = slots_[slot];
+  if (s.last_use == frame_) return;  // already used this frame: its place is final
+  s.last_use = frame_;
   policy_->on_touch(slot, frame_);
 }
 
@@ -92,16 +135,14 @@ std::optional<CacheInsertion> BrickCache::insert(BrickKey key) {
       return std::nullopt;
     }
     out.slot = *v;
-    out.evicted = BrickKey::from_bits(keys_[*v]);
+    out.evicted = BrickKey::from_bits(slots_[*v].key_bits);
     policy_->on_remove(*v);
-    index_.erase(keys_[*v]);
+    index_.erase(slots_[*v].key_bits);
     --resident_;
     ++stats_.evictions;
   }
-  keys_[out.slot] = key.bits();
-  last_use_[out.slot] = frame_;
-  uploaded_[out.slot] = frame_;
-  index_.emplace(key.bits(), out.slot);
+  slots_[out.slot] = CacheSlot{key.bits(), frame_, frame_};
+  index_.insert(key.bits(), out.slot);
   ++resident_;
   ++stats_.insertions;
   policy_->on_insert(out.slot, key, frame_);
@@ -109,10 +150,10 @@ std::optional<CacheInsertion> BrickCache::insert(BrickKey key) {
 }
 
 void BrickCache::release(std::uint32_t slot) {
-  if (slot >= keys_.size() || keys_[slot] == kFreeKey) return;
+  if (slot >= slots_.size() || slots_[slot].key_bits == kFreeKey) return;
   policy_->on_remove(slot);
-  index_.erase(keys_[slot]);
-  keys_[slot] = kFreeKey;
+  index_.erase(slots_[slot].key_bits);
+  slots_[slot].key_bits = kFreeKey;
   free_.push_back(slot);
   --resident_;
   ++stats_.releases;

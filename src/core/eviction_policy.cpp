@@ -10,8 +10,7 @@ namespace resoct {
 // ---- LRU ----------------------------------------------------------------------------------------
 
 void LruPolicy::reset(std::uint32_t slot_count) {
-  prev_.assign(slot_count, kNone);
-  next_.assign(slot_count, kNone);
+  links_.assign(slot_count, Link{});
   head_ = tail_ = cursor_ = kNone;
 }
 
@@ -20,17 +19,16 @@ void LruPolicy::begin_frame(std::uint64_t /*frame*/) {
 }
 
 void LruPolicy::unlink(std::uint32_t s) {
-  if (cursor_ == s) cursor_ = next_[s];
-  const std::uint32_t p = prev_[s], n = next_[s];
-  (p == kNone ? head_ : next_[p]) = n;
-  (n == kNone ? tail_ : prev_[n]) = p;
-  prev_[s] = next_[s] = kNone;
+  Link& link = links_[s];
+  if (cursor_ == s) cursor_ = link.next;
+  (link.prev == kNone ? head_ : links_[link.prev].next) = link.next;
+  (link.next == kNone ? tail_ : links_[link.next].prev) = link.prev;
+  link = Link{};
 }
 
 void LruPolicy::append(std::uint32_t s) {
-  prev_[s] = tail_;
-  next_[s] = kNone;
-  (tail_ == kNone ? head_ : next_[tail_]) = s;
+  links_[s] = Link{tail_, kNone};
+  (tail_ == kNone ? head_ : links_[tail_].next) = s;
   tail_ = s;
   // A cursor that ran off the end resumes at the new slot (which is pinned: used this frame).
   if (cursor_ == kNone) cursor_ = s;
@@ -54,9 +52,9 @@ std::optional<std::uint32_t> LruPolicy::victim(const PinState& pins) {
   while (cursor_ != kNone) {
     const std::uint32_t s = cursor_;
     // Slots used this frame sit at the tail, behind every other slot: nothing further is free.
-    if (pins.last_use[s] == pins.frame) return std::nullopt;
+    if (pins.last_use(s) == pins.frame) return std::nullopt;
     if (!pins.pinned(s)) return s;
-    cursor_ = next_[s];  // pinned by ttl for the rest of this frame
+    cursor_ = links_[s].next;  // pinned by ttl for the rest of this frame
   }
   return std::nullopt;
 }
@@ -102,59 +100,63 @@ double OctreemizerPolicy::priority(std::uint32_t slot, std::uint64_t frame) cons
   return w_.ka * double(frame - e.last_use) + w_.kl * depth + w_.kd * e.distance;
 }
 
-void OctreemizerPolicy::place(std::size_t i, std::uint32_t slot) {
-  heap_[i] = slot;
-  pos_[slot] = std::uint32_t(i);
+void OctreemizerPolicy::place(std::size_t i, const HeapItem& item) {
+  heap_[i] = item;
+  pos_[item.slot] = std::uint32_t(i);
 }
 
 void OctreemizerPolicy::sift_up(std::size_t i) {
-  const std::uint32_t s = heap_[i];
-  const double r = rank(s);
+  const HeapItem item = heap_[i];
   while (i > 0) {
     const std::size_t parent = (i - 1) / 2;
-    if (rank(heap_[parent]) >= r) break;
+    if (heap_[parent].rank >= item.rank) break;
     place(i, heap_[parent]);
     i = parent;
   }
-  place(i, s);
+  place(i, item);
 }
 
 void OctreemizerPolicy::sift_down(std::size_t i) {
-  const std::uint32_t s = heap_[i];
-  const double r = rank(s);
+  const HeapItem item = heap_[i];
   const std::size_t n = heap_.size();
   for (;;) {
     std::size_t c = 2 * i + 1;
     if (c >= n) break;
-    if (c + 1 < n && rank(heap_[c + 1]) > rank(heap_[c])) ++c;
-    if (rank(heap_[c]) <= r) break;
+    if (c + 1 < n && heap_[c + 1].rank > heap_[c].rank) ++c;
+    if (heap_[c].rank <= item.rank) break;
     place(i, heap_[c]);
     i = c;
   }
-  place(i, s);
+  place(i, item);
 }
 
 void OctreemizerPolicy::heap_push(std::uint32_t slot) {
-  heap_.push_back(slot);
+  heap_.push_back(HeapItem{rank(slot), slot});
   pos_[slot] = std::uint32_t(heap_.size() - 1);
   sift_up(heap_.size() - 1);
 }
 
 void OctreemizerPolicy::heap_erase(std::uint32_t slot) {
   const std::size_t i = pos_[slot];
-  const std::uint32_t last = heap_.back();
+  const HeapItem last = heap_.back();
   heap_.pop_back();
   pos_[slot] = kAbsent;
-  if (last == slot) return;
+  if (last.slot == slot) return;
   place(i, last);
   sift_up(i);
-  sift_down(pos_[last]);
+  sift_down(pos_[last.slot]);
 }
 
 void OctreemizerPolicy::heap_fix(std::uint32_t slot) {
   if (pos_[slot] >= kParked) return;  // parked or free: ordered when it returns to the heap
-  sift_up(pos_[slot]);
-  sift_down(pos_[slot]);
+  const std::size_t i = pos_[slot];
+  const double old = heap_[i].rank;
+  heap_[i].rank = rank(slot);
+  if (heap_[i].rank > old) {
+    sift_up(i);
+  } else {
+    sift_down(i);
+  }
 }
 
 void OctreemizerPolicy::begin_frame(std::uint64_t /*frame*/) {
@@ -196,7 +198,7 @@ void OctreemizerPolicy::set_distance(std::uint32_t slot, double distance) {
 
 std::optional<std::uint32_t> OctreemizerPolicy::victim(const PinState& pins) {
   while (!heap_.empty()) {
-    const std::uint32_t s = heap_.front();
+    const std::uint32_t s = heap_.front().slot;
     if (!pins.pinned(s)) return s;
     // Pinned for the rest of this frame: park it so later searches do not meet it again.
     heap_erase(s);

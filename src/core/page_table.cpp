@@ -37,6 +37,14 @@ PageTable::PageTable(const BrickHierarchy& hierarchy, std::uint32_t slots)
                                          " entries, more than 32-bit indices address; use bigger "
                                          "bricks or fewer visible slots");
   }
+  for (std::uint32_t l = 0; l < levels_; ++l) {
+    const LevelInfo& li = hierarchy.level(l);
+    LevelScale ls;
+    ls.scale = hierarchy.level_voxel_position(l, glm::dvec3(1.0));
+    ls.last_voxel = glm::dvec3(li.extent - glm::u64vec3(1u));
+    ls.bricks = li.bricks;
+    scales_.push_back(ls);
+  }
   offsets_.reserve(table_count() + 1u);
   std::uint32_t at = 0;
   for (std::uint32_t s = 0; s < slots_; ++s) {
@@ -80,19 +88,20 @@ std::uint32_t PageTable::entry_index(const PageAddress& a) const {
 PageLookup PageTable::translate(std::uint32_t level, std::uint32_t slot,
                                 const glm::dvec3& p) const {
   const std::uint32_t t = table_id(slot, level);
-  const LevelInfo& li = hierarchy_.level(level);
-  const BrickLayout& layout = hierarchy_.layout();
-  const glm::dvec3 x = hierarchy_.level_voxel_position(level, glm::clamp(p, 0.0, 1.0));
+  const LevelScale& ls = scales_[level];
+  const glm::uvec3 b = hierarchy_.layout().brick_size;
+  const std::uint32_t halo = hierarchy_.layout().halo;
   PageLookup out;
   for (int i = 0; i < 3; ++i) {
     // Voxel first, then brick (floor(floor(x) / b)): correct for partial border bricks. p = 1
     // lands on the far face and belongs to the last voxel.
-    const double v = std::min(std::floor(x[i]), double(li.extent[i] - 1u));
-    out.voxel[i] = std::uint32_t(std::max(v, 0.0));
-    out.brick[i] = out.voxel[i] / layout.brick_size[i];
-    out.padded_offset[i] = out.voxel[i] - out.brick[i] * layout.brick_size[i] + layout.halo;
+    const double c = p[i] > 0.0 ? std::min(p[i], 1.0) : 0.0;  // NaN reads as 0
+    const double x = c * ls.scale[i];
+    out.voxel[i] = std::uint32_t(std::min(std::floor(x), ls.last_voxel[i]));
+    out.brick[i] = out.voxel[i] / b[i];
+    out.padded_offset[i] = out.voxel[i] - out.brick[i] * b[i] + halo;
   }
-  out.entry_index = offsets_[t] + k::page_local_index(out.brick, li.bricks);
+  out.entry_index = offsets_[t] + k::page_local_index(out.brick, ls.bricks);
   out.entry = entries_[out.entry_index];
   return out;
 }

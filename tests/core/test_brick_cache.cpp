@@ -277,3 +277,28 @@ TEST(UploadBudget, AdmitsInOrderUntilEitherBudgetIsExhausted) {
   p = plan_uploads({}, UploadBudget{1, 1});
   EXPECT_TRUE(p.admitted.empty() && p.deferred.empty());
 }
+
+TEST(BrickCache, KeySlotIndexMatchesAMapUnderChurn) {
+  detail::KeySlotIndex index;
+  index.reset(64);  // 128 cells: long probe runs and many backward shifts
+  std::map<std::uint64_t, std::uint32_t> ref;
+  std::mt19937_64 gen(77);
+  for (int i = 0; i < 20000; ++i) {
+    const std::uint64_t key = gen() % 200;
+    if (ref.count(key)) {
+      index.erase(key);
+      ref.erase(key);
+    } else if (ref.size() < 64) {
+      const auto slot = std::uint32_t(gen() % 1000);
+      index.insert(key, slot);
+      ref[key] = slot;
+    }
+    if (i % 97 == 0) {
+      for (std::uint64_t k = 0; k < 200; ++k) {
+        const auto it = ref.find(k);
+        ASSERT_EQ(index.find(k), it == ref.end() ? std::nullopt : std::optional(it->second));
+      }
+    }
+  }
+  index.erase(12345);  // absent: no-op
+}

@@ -2,6 +2,7 @@
 // awkward volumes at every level, the delta list, homogeneous values, and limits.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <random>
 
@@ -117,6 +118,8 @@ TEST(PageTable, TranslationClampsAndHandlesFacesAndBrickBorders) {
   EXPECT_EQ(r.padded_offset, glm::uvec3(8, 1, 1));
   r = pt.translate(0, 0, glm::dvec3(-0.5, 2.0, 0.0));
   EXPECT_EQ(r.voxel, glm::uvec3(0, 32, 0));
+  r = pt.translate(1, 0, glm::dvec3(std::nan(""), 1.0, 0.5));
+  EXPECT_EQ(r.voxel, glm::uvec3(0, 16, 8));  // level 1 is 20 x 17 x 17
   // Exactly on a brick border: voxel 8 starts brick 1.
   r = pt.translate(0, 0, glm::dvec3(8.0 / 40.0, 0.0, 0.0));
   EXPECT_EQ(r.voxel.x, 8u);
