@@ -9,7 +9,10 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "resoct/brick_key.hpp"
+#include "resoct/hierarchy.hpp"
 
 namespace resoct {
 
@@ -87,6 +90,11 @@ struct OctreemizerWeights {
   double kl = 16.0;
   double kd = 1.0;
 };
+
+/// Distance from a camera (physical coordinates: level-0 voxel units times spacing, origin at the
+/// volume's corner) to the centre of a brick's level-0 footprint; a ready-made distance for
+/// OctreemizerPolicy. Throws Error(out_of_range) for a key outside the hierarchy.
+double brick_camera_distance(const BrickHierarchy& h, BrickKey key, const glm::dvec3& camera);
 
 /// Indexed binary max-heap on the frame-independent part of p (ka * frame is common to all
 /// slots, so q = kl * depth + kd * distance - ka * last_use orders like p). Touch, insert, remove

@@ -1,6 +1,8 @@
 #include "resoct/eviction_policy.hpp"
 
 #include <cmath>
+
+#include <glm/geometric.hpp>
 #include <string>
 
 #include "resoct/error.hpp"
@@ -57,6 +59,15 @@ std::optional<std::uint32_t> LruPolicy::victim(const PinState& pins) {
     cursor_ = links_[s].next;  // pinned by ttl for the rest of this frame
   }
   return std::nullopt;
+}
+
+double brick_camera_distance(const BrickHierarchy& h, BrickKey key, const glm::dvec3& camera) {
+  if (key.level() >= h.level_count() || !h.contains(BrickKey(key.level(), 0, key.brick()))) {
+    throw Error(ErrorCode::out_of_range, "brick key outside the hierarchy");
+  }
+  const Box3 box = h.level0_box(key.level(), key.brick());
+  const glm::dvec3 centre = 0.5 * glm::dvec3(box.lo + box.hi) * h.volume().spacing;
+  return glm::length(centre - camera);
 }
 
 // ---- Octreemizer --------------------------------------------------------------------------------

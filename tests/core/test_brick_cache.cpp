@@ -302,3 +302,20 @@ TEST(BrickCache, KeySlotIndexMatchesAMapUnderChurn) {
   }
   index.erase(12345);  // absent: no-op
 }
+
+TEST(BrickCache, BrickCameraDistanceUsesTheLevel0FootprintCentre) {
+  VolumeDesc v;
+  v.extent = {40, 33, 17};
+  v.spacing = {1.0, 2.0, 0.5};
+  const BrickHierarchy h(v, BrickLayout{glm::uvec3(8), 1});
+  // Level 0 brick (4, 4, 2) covers voxels [32, 40) x [32, 33) x [16, 17): centre (36, 32.5, 16.5).
+  const glm::dvec3 c(36.0 * 1.0, 32.5 * 2.0, 16.5 * 0.5);
+  EXPECT_DOUBLE_EQ(brick_camera_distance(h, BrickKey(0, 0, {4, 4, 2}), c + glm::dvec3(3, 4, 0)),
+                   5.0);
+  // The coarsest brick covers the whole volume.
+  const glm::dvec3 mid = glm::dvec3(20.0, 16.5 * 2.0, 8.5 * 0.5);
+  EXPECT_DOUBLE_EQ(brick_camera_distance(h, BrickKey(h.level_count() - 1, 0, {0, 0, 0}), mid),
+                   0.0);
+  EXPECT_RESOCT_ERROR(brick_camera_distance(h, BrickKey(0, 0, {5, 0, 0}), mid),
+                      ErrorCode::out_of_range, "outside");
+}
