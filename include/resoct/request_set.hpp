@@ -52,7 +52,8 @@ class RequestSet {
   std::uint32_t max_probes() const noexcept { return max_probes_; }
 
   /// Adds `hits` to key's count, inserting it if absent. False (and counted) when the set is
-  /// full, the probe bound is hit, or the key is the reserved kRequestKeyNone. Lock-free.
+  /// full, the probe bound is hit, or the key is the reserved kRequestKeyNone. Lock-free. Counts
+  /// are 32-bit and wrap past 2^32 - 1 hits in one frame: insert once per ray, not per sample.
   bool insert(std::uint32_t key, std::uint32_t hits = 1) noexcept;
 
   /// Distinct keys stored this frame.

@@ -314,8 +314,7 @@ TEST(BrickCache, BrickCameraDistanceUsesTheLevel0FootprintCentre) {
                    5.0);
   // The coarsest brick covers the whole volume.
   const glm::dvec3 mid = glm::dvec3(20.0, 16.5 * 2.0, 8.5 * 0.5);
-  EXPECT_DOUBLE_EQ(brick_camera_distance(h, BrickKey(h.level_count() - 1, 0, {0, 0, 0}), mid),
-                   0.0);
+  EXPECT_DOUBLE_EQ(brick_camera_distance(h, BrickKey(h.level_count() - 1, 0, {0, 0, 0}), mid), 0.0);
   EXPECT_RESOCT_ERROR(brick_camera_distance(h, BrickKey(0, 0, {5, 0, 0}), mid),
                       ErrorCode::out_of_range, "outside");
 }
