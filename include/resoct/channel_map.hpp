@@ -5,10 +5,12 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "resoct/brick_key.hpp"
 #include "resoct/page_table.hpp"
+#include "resoct/request_set.hpp"
 
 namespace resoct {
 
@@ -17,6 +19,13 @@ struct SlotRemap {
   std::uint64_t epoch = 0;  ///< the epoch from which the new mapping holds
   /// Cache slots whose bricks belonged to the slot's old channel: release them in the cache.
   std::vector<std::uint32_t> released_cache_slots;
+};
+
+/// Drained brick requests translated to global bricks, in the order they were given.
+struct ResolvedRequests {
+  std::vector<BrickKey> bricks;
+  std::vector<std::uint32_t> hits;  ///< parallel to bricks
+  std::uint64_t stale = 0;          ///< requests dropped: remapped or unassigned slot, bad key
 };
 
 /// Slot <-> channel map. Epoch 0 is the initial (all slots unassigned) state; every assign()
@@ -51,6 +60,9 @@ class ChannelMap {
   /// for an epoch from the future (a caller bug, not device data).
   std::optional<BrickKey> resolve(std::uint32_t device_key, std::uint64_t epoch,
                                   const PageTable& table) const;
+  /// resolve() for a frame's drained brick requests, keeping their (priority) order.
+  ResolvedRequests resolve(std::span<const Request> requests, std::uint64_t epoch,
+                           const PageTable& table) const;
   /// The page-table address of a global brick, nullopt when its channel is not visible.
   std::optional<PageAddress> address_of(BrickKey key) const;
 

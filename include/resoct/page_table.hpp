@@ -38,6 +38,13 @@ struct PageLookup {
   glm::uvec3 brick{0};            ///< brick coordinates at the level
   glm::uvec3 voxel{0};            ///< level voxel, clamped to the level extent
   glm::uvec3 padded_offset{0};    ///< voxel within the padded brick: core offset + halo
+
+  bool mapped() const noexcept { return kernel::page_is_mapped(entry); }
+  /// Cache slot of a MAPPED entry, nullopt otherwise.
+  std::optional<std::uint32_t> cache_slot() const noexcept {
+    if (!mapped()) return std::nullopt;
+    return kernel::page_cache_slot(entry);
+  }
 };
 
 /// Host-authoritative page table. Table id t = slot * level_count + level; table t occupies

@@ -87,6 +87,22 @@ std::optional<BrickKey> ChannelMap::resolve(std::uint32_t device_key, std::uint6
   return BrickKey(a->level, std::uint32_t(slot_channel_[a->slot]), a->brick);
 }
 
+ResolvedRequests ChannelMap::resolve(std::span<const Request> requests, std::uint64_t epoch,
+                                     const PageTable& table) const {
+  ResolvedRequests out;
+  out.bricks.reserve(requests.size());
+  out.hits.reserve(requests.size());
+  for (const Request& r : requests) {
+    if (const std::optional<BrickKey> key = resolve(r.key, epoch, table)) {
+      out.bricks.push_back(*key);
+      out.hits.push_back(r.hits);
+    } else {
+      ++out.stale;
+    }
+  }
+  return out;
+}
+
 std::optional<PageAddress> ChannelMap::address_of(BrickKey key) const {
   const std::optional<std::uint32_t> s = slot_of(key.channel());
   if (!s) return std::nullopt;

@@ -100,3 +100,29 @@ TEST(ChannelMap, LookupsBothWaysAndErrors) {
   EXPECT_EQ(cm.slot_of(3), 0u);
   EXPECT_EQ(cm.assigned_at(0), cm.epoch());
 }
+
+TEST(ChannelMap, ResolvesADrainedBatchAndCountsStaleRequests) {
+  const BrickHierarchy h = hierarchy(4);
+  PageTable pt(h, 2);
+  ChannelMap cm(2, 4);
+  cm.assign(0, 1, pt);
+  cm.assign(1, 3, pt);
+  const std::uint64_t recorded = cm.epoch();
+  RequestSet rs(64);
+  const PageAddress a{0, 0, {1, 2, 0}}, b{1, 2, {0, 1, 0}}, c{0, 1, {2, 0, 1}};
+  rs.insert(pt.device_key(a), 5);
+  rs.insert(pt.device_key(b), 9);
+  rs.insert(pt.device_key(c), 2);
+  rs.insert(k::request_key_encode(pt.table_count(), 0));  // garbage from the device
+  cm.assign(1, 2, pt);                                    // slot 1 remapped after recording
+  const RequestBatch batch = rs.drain([&](std::uint32_t key) {
+    const auto d = pt.decode_device_key(key);
+    return d ? d->level : 0u;
+  });
+  const ResolvedRequests r = cm.resolve(batch.requests, recorded, pt);
+  // b (slot 1) is stale; the garbage key is stale; c (level 1) comes before a (level 0).
+  EXPECT_EQ(r.bricks,
+            (std::vector<BrickKey>{BrickKey(1, 1, {2, 0, 1}), BrickKey(0, 1, {1, 2, 0})}));
+  EXPECT_EQ(r.hits, (std::vector<std::uint32_t>{2, 5}));
+  EXPECT_EQ(r.stale, 2u);
+}

@@ -88,6 +88,7 @@ void check_every_voxel(const BrickHierarchy& h, std::uint32_t slots) {
           ASSERT_EQ(glm::u64vec3(r.padded_offset), off);
           ASSERT_EQ(r.entry_index, idx);
           ASSERT_EQ(r.entry, k::page_encode_mapped(std::uint32_t(idx) * 7u + 1u));
+          ASSERT_EQ(r.cache_slot(), std::uint32_t(idx) * 7u + 1u);
           ++checked;
         }
       }
@@ -116,6 +117,8 @@ TEST(PageTable, TranslationClampsAndHandlesFacesAndBrickBorders) {
   EXPECT_EQ(r.voxel, glm::uvec3(39, 32, 16));
   EXPECT_EQ(r.brick, glm::uvec3(4, 4, 2));
   EXPECT_EQ(r.padded_offset, glm::uvec3(8, 1, 1));
+  EXPECT_FALSE(r.mapped());
+  EXPECT_FALSE(r.cache_slot().has_value());
   r = pt.translate(0, 0, glm::dvec3(-0.5, 2.0, 0.0));
   EXPECT_EQ(r.voxel, glm::uvec3(0, 32, 0));
   r = pt.translate(1, 0, glm::dvec3(std::nan(""), 1.0, 0.5));
