@@ -63,7 +63,8 @@ class BrickCache {
  public:
   /// Throws Error(invalid_argument) naming "capacity_bytes" when it is 0, smaller than one padded
   /// brick, or yields more slots than a page entry can address (2^30); the layout is validated.
-  /// `policy` defaults to LruPolicy.
+  /// Error(out_of_memory) when the host cannot hold the bookkeeping. `policy` defaults to
+  /// LruPolicy.
   BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t capacity_bytes,
              std::uint32_t ttl = 2, std::unique_ptr<EvictionPolicy> policy = nullptr);
 

@@ -55,7 +55,8 @@ class PageTable {
  public:
   /// Throws Error(invalid_argument) naming "slots" when slots is 0, or when the hierarchy does not
   /// fit 32-bit device request keys (kernel/request_key.glsl.h): more than 128 (slot, level)
-  /// tables, a level with 2^25 - 1 or more bricks, or more than 2^32 - 1 entries in total.
+  /// tables, a level with 2^25 - 1 or more bricks, or more than 2^32 - 1 entries in total;
+  /// Error(out_of_memory) when the host cannot hold the entries.
   PageTable(const BrickHierarchy& hierarchy, std::uint32_t slots);
 
   const BrickHierarchy& hierarchy() const noexcept { return hierarchy_; }

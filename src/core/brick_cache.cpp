@@ -1,5 +1,6 @@
 #include "resoct/brick_cache.hpp"
 
+#include <new>
 #include <string>
 
 #include "resoct/error.hpp"
@@ -71,12 +72,17 @@ BrickCache::BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t 
   }
   if (!policy_) policy_ = std::make_unique<LruPolicy>();
   const auto n = std::uint32_t(slots);
-  slots_.assign(n, CacheSlot{kFreeKey, 0, 0});
-  free_.resize(n);
+  try {
+    slots_.assign(n, CacheSlot{kFreeKey, 0, 0});
+    free_.resize(n);
+    index_.reset(n);
+    policy_->reset(n);
+  } catch (const std::bad_alloc&) {
+    throw Error(ErrorCode::out_of_memory, "capacity_bytes: no host memory for the bookkeeping of " +
+                                              std::to_string(n) + " cache slots");
+  }
   // Lowest slot first: free_ is a stack.
   for (std::uint32_t i = 0; i < n; ++i) free_[i] = n - 1u - i;
-  index_.reset(n);
-  policy_->reset(n);
   policy_->begin_frame(frame_);
 }
 

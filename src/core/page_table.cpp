@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <string>
 
 #include "resoct/error.hpp"
@@ -54,8 +55,13 @@ PageTable::PageTable(const BrickHierarchy& hierarchy, std::uint32_t slots)
     }
   }
   offsets_.push_back(at);
-  entries_.assign(at, k::kPageUnmappedWord);
-  dirty_bits_.assign((std::size_t(at) + 63u) / 64u, 0u);
+  try {
+    entries_.assign(at, k::kPageUnmappedWord);
+    dirty_bits_.assign((std::size_t(at) + 63u) / 64u, 0u);
+  } catch (const std::bad_alloc&) {
+    throw Error(ErrorCode::out_of_memory,
+                "slots: no host memory for " + std::to_string(at) + " page-table entries");
+  }
 }
 
 void PageTable::check_slot(std::uint32_t slot) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <new>
 #include <string>
 
 #include "resoct/error.hpp"
@@ -20,9 +21,14 @@ RequestSet::RequestSet(std::uint32_t capacity, std::uint32_t max_probes) {
   mask_ = cap - 1u;
   log2_capacity_ = std::uint32_t(std::countr_zero(cap));
   max_probes_ = std::min(max_probes, cap);
-  keys_ = std::make_unique<std::atomic<std::uint32_t>[]>(cap);
-  hits_ = std::make_unique<std::atomic<std::uint32_t>[]>(cap);
-  filled_slots_ = std::make_unique<std::uint32_t[]>(cap);
+  try {
+    keys_ = std::make_unique<std::atomic<std::uint32_t>[]>(cap);
+    hits_ = std::make_unique<std::atomic<std::uint32_t>[]>(cap);
+    filled_slots_ = std::make_unique<std::uint32_t[]>(cap);
+  } catch (const std::bad_alloc&) {
+    throw Error(ErrorCode::out_of_memory,
+                "capacity: no host memory for a request set of " + std::to_string(cap) + " keys");
+  }
   for (std::uint32_t i = 0; i < cap; ++i) {
     keys_[i].store(k::kRequestKeyNone, std::memory_order_relaxed);
     hits_[i].store(0, std::memory_order_relaxed);
