@@ -1,0 +1,78 @@
+// resoct single-source kernel: the page-table entry word (one uint per brick, per slot and level).
+//
+// Layout of an entry (std430-safe: a plain uint in a storage buffer):
+//   bits 30-31  state: UNMAPPED (0), MAPPED (1), EMPTY (2), HOMOGENEOUS (3)
+//   bits  0-29  payload:
+//               MAPPED       cache slot index, 0 .. kPageMaxCacheSlot
+//               EMPTY        0 (the brick is constant zero: transparent for every transfer
+//               function) HOMOGENEOUS  bits 0-15 the constant value as unorm16 of the channel's
+//               value range,
+//                            bits 16-29 zero
+//               UNMAPPED     0
+// UNMAPPED is the all-zero word so that a zero-filled buffer is a valid, empty page table.
+//
+// Precision of HOMOGENEOUS: the device sees the value quantised to 1/65535 of the channel's value
+// range, which is exact for u8 and for u16 with the default range. The host page table keeps the
+// exact value (u16 or f32) beside the entry, so nothing is lost for host-side consumers.
+#ifndef RESOCT_KERNEL_PAGE_ENTRY_GLSL_H
+#define RESOCT_KERNEL_PAGE_ENTRY_GLSL_H
+
+#include "resoct/kernel/common.glsl.h"
+
+RESOCT_KERNEL_BEGIN
+
+RESOCT_CONST(uint, kPageStateShift, 30u);
+RESOCT_CONST(uint, kPagePayloadMask, 0x3FFFFFFFu);
+RESOCT_CONST(uint, kPageStateUnmapped, 0u);
+RESOCT_CONST(uint, kPageStateMapped, 1u);
+RESOCT_CONST(uint, kPageStateEmpty, 2u);
+RESOCT_CONST(uint, kPageStateHomogeneous, 3u);
+// Largest cache slot index a MAPPED entry can hold (2^30 - 1, ~1 G bricks).
+RESOCT_CONST(uint, kPageMaxCacheSlot, 0x3FFFFFFFu);
+RESOCT_CONST(uint, kPageHomogeneousMask, 0xFFFFu);
+RESOCT_CONST(uint, kPageUnmappedWord, 0u);
+RESOCT_CONST(uint, kPageEmptyWord, 0x80000000u);
+
+RESOCT_FN uint page_state(uint entry) {
+  return entry >> kPageStateShift;
+}
+
+RESOCT_FN uint page_payload(uint entry) {
+  return entry & kPagePayloadMask;
+}
+
+RESOCT_FN uint page_encode_mapped(uint cache_slot) {
+  return (kPageStateMapped << kPageStateShift) | (cache_slot & kPagePayloadMask);
+}
+
+RESOCT_FN uint page_encode_homogeneous(uint unorm16) {
+  return (kPageStateHomogeneous << kPageStateShift) | (unorm16 & kPageHomogeneousMask);
+}
+
+RESOCT_FN bool page_is_mapped(uint entry) {
+  return page_state(entry) == kPageStateMapped;
+}
+
+// Cache slot of a MAPPED entry (meaningless for other states).
+RESOCT_FN uint page_cache_slot(uint entry) {
+  return entry & kPagePayloadMask;
+}
+
+// Normalised [0, 1] value of a HOMOGENEOUS entry; EMPTY reads as 0.
+RESOCT_FN float page_homogeneous_value(uint entry) {
+  return float(entry & kPageHomogeneousMask) / 65535.0f;
+}
+
+// True when the entry needs no brick access: EMPTY or HOMOGENEOUS.
+RESOCT_FN bool page_is_constant(uint entry) {
+  return page_state(entry) >= kPageStateEmpty;
+}
+
+// Index of a brick within one (slot, level) table: x fastest, as BrickHierarchy::linear_index.
+RESOCT_FN uint page_local_index(uvec3 brick, uvec3 bricks) {
+  return brick.x + bricks.x * (brick.y + bricks.y * brick.z);
+}
+
+RESOCT_KERNEL_END
+
+#endif  // RESOCT_KERNEL_PAGE_ENTRY_GLSL_H

@@ -1,0 +1,271 @@
+// Page table: address translation against a brute-force integer definition for every voxel of
+// awkward volumes at every level, the delta list, homogeneous values, and limits.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "resoct/kernel/request_key.glsl.h"
+#include "resoct/page_table.hpp"
+#include "support/expect_error.hpp"
+
+using namespace resoct;
+namespace k = resoct::kernel;
+
+namespace {
+
+BrickHierarchy make(glm::u64vec3 extent, glm::uvec3 brick, std::uint32_t halo) {
+  VolumeDesc v;
+  v.extent = extent;
+  return BrickHierarchy(v, BrickLayout{brick, halo});
+}
+
+std::uint64_t ceil_div(std::uint64_t a, std::uint64_t b) {
+  return (a + b - 1) / b;
+}
+
+// Independent model of the flat layout: tables in (slot, level) order, bricks x fastest.
+struct BruteLayout {
+  std::vector<glm::u64vec3> extent;  // per level
+  std::vector<glm::u64vec3> bricks;
+  std::vector<std::uint64_t> offset;  // per table
+  BruteLayout(const BrickHierarchy& h, std::uint32_t slots) {
+    std::uint64_t at = 0;
+    for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+      glm::u64vec3 e, b;
+      for (int i = 0; i < 3; ++i) {
+        const std::uint64_t f = std::uint64_t(1) << h.level(l).factor_log2[i];
+        e[i] = ceil_div(h.volume().extent[i], f);
+        b[i] = ceil_div(e[i], h.layout().brick_size[i]);
+      }
+      extent.push_back(e);
+      bricks.push_back(b);
+    }
+    for (std::uint32_t s = 0; s < slots; ++s) {
+      for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+        offset.push_back(at);
+        at += bricks[l].x * bricks[l].y * bricks[l].z;
+      }
+    }
+  }
+};
+
+void check_every_voxel(const BrickHierarchy& h, std::uint32_t slots) {
+  PageTable pt(h, slots);
+  const BruteLayout bl(h, slots);
+  // Give each brick a distinct MAPPED entry so that the looked-up word identifies the brick.
+  for (std::uint32_t s = 0; s < slots; ++s)
+    for (std::uint32_t l = 0; l < h.level_count(); ++l)
+      for (std::uint32_t z = 0; z < bl.bricks[l].z; ++z)
+        for (std::uint32_t y = 0; y < bl.bricks[l].y; ++y)
+          for (std::uint32_t x = 0; x < bl.bricks[l].x; ++x) {
+            const PageAddress a{s, l, {x, y, z}};
+            pt.set_mapped(a, pt.entry_index(a) * 7u + 1u);
+          }
+  const glm::u64vec3 e0 = h.volume().extent;
+  const glm::uvec3 b = h.layout().brick_size;
+  const std::uint32_t halo = h.layout().halo;
+  std::uint64_t checked = 0;
+  for (std::uint64_t z = 0; z < e0.z; ++z)
+    for (std::uint64_t y = 0; y < e0.y; ++y)
+      for (std::uint64_t x = 0; x < e0.x; ++x) {
+        const glm::u64vec3 u(x, y, z);
+        const glm::dvec3 p = (glm::dvec3(u) + 0.5) / glm::dvec3(e0);
+        for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+          const std::uint32_t s = std::uint32_t((x + y + z + l) % slots);
+          glm::u64vec3 v, br, off;
+          for (int i = 0; i < 3; ++i) {
+            v[i] = u[i] >> h.level(l).factor_log2[i];
+            br[i] = v[i] / b[i];
+            off[i] = v[i] % b[i] + halo;
+          }
+          const std::uint64_t idx = bl.offset[s * h.level_count() + l] + br.x +
+                                    bl.bricks[l].x * (br.y + bl.bricks[l].y * br.z);
+          const PageLookup r = pt.translate(l, s, p);
+          ASSERT_EQ(glm::u64vec3(r.voxel), v) << "voxel " << x << "," << y << "," << z << " l" << l;
+          ASSERT_EQ(glm::u64vec3(r.brick), br);
+          ASSERT_EQ(glm::u64vec3(r.padded_offset), off);
+          ASSERT_EQ(r.entry_index, idx);
+          ASSERT_EQ(r.entry, k::page_encode_mapped(std::uint32_t(idx) * 7u + 1u));
+          ASSERT_EQ(r.cache_slot(), std::uint32_t(idx) * 7u + 1u);
+          ++checked;
+        }
+      }
+  EXPECT_EQ(checked, e0.x * e0.y * e0.z * h.level_count());
+}
+
+}  // namespace
+
+TEST(PageTable, TranslationMatchesBruteForceForEveryVoxel_40x33x17) {
+  check_every_voxel(make({40, 33, 17}, glm::uvec3(8), 1), 2);
+}
+
+TEST(PageTable, TranslationMatchesBruteForceForEveryVoxel_795x3x1) {
+  check_every_voxel(make({795, 3, 1}, glm::uvec3(8), 2), 3);
+}
+
+TEST(PageTable, TranslationMatchesBruteForceForEveryVoxel_AnisotropicBricks) {
+  check_every_voxel(make({37, 50, 23}, glm::uvec3(4, 5, 6), 0), 1);
+}
+
+TEST(PageTable, TranslationClampsAndHandlesFacesAndBrickBorders) {
+  const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
+  PageTable pt(h, 1);
+  // p = 1 lies on the far face and belongs to the last voxel (in the partial last brick).
+  PageLookup r = pt.translate(0, 0, glm::dvec3(1.0));
+  EXPECT_EQ(r.voxel, glm::uvec3(39, 32, 16));
+  EXPECT_EQ(r.brick, glm::uvec3(4, 4, 2));
+  EXPECT_EQ(r.padded_offset, glm::uvec3(8, 1, 1));
+  EXPECT_FALSE(r.mapped());
+  EXPECT_FALSE(r.cache_slot().has_value());
+  r = pt.translate(0, 0, glm::dvec3(-0.5, 2.0, 0.0));
+  EXPECT_EQ(r.voxel, glm::uvec3(0, 32, 0));
+  r = pt.translate(1, 0, glm::dvec3(std::nan(""), 1.0, 0.5));
+  EXPECT_EQ(r.voxel, glm::uvec3(0, 16, 8));  // level 1 is 20 x 17 x 17
+  // Exactly on a brick border: voxel 8 starts brick 1.
+  r = pt.translate(0, 0, glm::dvec3(8.0 / 40.0, 0.0, 0.0));
+  EXPECT_EQ(r.voxel.x, 8u);
+  EXPECT_EQ(r.brick.x, 1u);
+  EXPECT_EQ(r.padded_offset.x, 1u);
+  EXPECT_RESOCT_ERROR(pt.translate(h.level_count(), 0, glm::dvec3(0.5)), ErrorCode::out_of_range,
+                      "level");
+  EXPECT_RESOCT_ERROR(pt.translate(0, 1, glm::dvec3(0.5)), ErrorCode::out_of_range, "slot");
+}
+
+TEST(PageTable, DeltasAreDeduplicatedAndReproduceTheTable) {
+  const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
+  PageTable pt(h, 2);
+  std::mt19937 gen(1234);
+  auto rng = [&] { return std::uint32_t(gen()); };
+  std::vector<std::uint32_t> device = pt.entries();  // what a backend holds
+  for (int round = 0; round < 20; ++round) {
+    std::map<std::uint32_t, bool> changed;  // reference: indices whose value changed
+    const int ops = int(rng() % 300);
+    for (int i = 0; i < ops; ++i) {
+      const std::uint32_t s = rng() % 2, l = rng() % h.level_count();
+      const glm::uvec3 nb = h.level(l).bricks;
+      const PageAddress a{s, l, {rng() % nb.x, rng() % nb.y, rng() % nb.z}};
+      const std::uint32_t before = pt.entry(a);
+      switch (rng() % 4) {
+        case 0: pt.set_mapped(a, rng() % 64); break;
+        case 1: pt.set_empty(a); break;
+        case 2: pt.set_unmapped(a); break;
+        default: pt.set_homogeneous(a, double(rng() % 256), ValueRange{0, 255}); break;
+      }
+      if (pt.entry(a) != before) changed[pt.entry_index(a)] = true;
+    }
+    const std::vector<PageDelta> d = pt.take_deltas();
+    ASSERT_EQ(d.size(), changed.size());
+    auto it = changed.begin();
+    for (const PageDelta& x : d) {
+      EXPECT_EQ(x.index, it->first);  // sorted and unique
+      EXPECT_EQ(x.value, pt.entries()[x.index]);
+      device[x.index] = x.value;
+      ++it;
+    }
+    ASSERT_EQ(device, pt.entries());
+    EXPECT_EQ(pt.pending_delta_count(), 0u);
+  }
+  EXPECT_TRUE(pt.take_deltas().empty());
+}
+
+TEST(PageTable, HomogeneousKeepsTheExactValueOnTheHost) {
+  const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
+  PageTable pt(h, 1);
+  const PageAddress a{0, 0, {1, 2, 0}}, b{0, 1, {0, 0, 0}};
+  pt.set_homogeneous(a, 1234.0, ValueRange{0, 65535});  // u16, default range: exact in unorm16
+  EXPECT_EQ(pt.entry(a), k::page_encode_homogeneous(1234u));
+  EXPECT_EQ(pt.homogeneous_value(a), 1234.0);
+  const double f = 0.123456789012345;  // f32 data: the device sees the rounded unorm16
+  pt.set_homogeneous(b, f, ValueRange{0, 1});
+  EXPECT_EQ(k::page_payload(pt.entry(b)), std::uint32_t(std::lround(f * 65535.0)));
+  EXPECT_EQ(pt.homogeneous_value(b), f);
+  pt.set_homogeneous(b, 7.5, ValueRange{0, 1});  // outside the range: clamped on the device only
+  EXPECT_EQ(k::page_payload(pt.entry(b)), 65535u);
+  EXPECT_EQ(pt.homogeneous_value(b), 7.5);
+  pt.set_mapped(b, 3);
+  EXPECT_FALSE(pt.homogeneous_value(b).has_value());
+  EXPECT_RESOCT_ERROR(pt.set_homogeneous(a, std::nan(""), ValueRange{}),
+                      ErrorCode::invalid_argument, "value");
+}
+
+TEST(PageTable, ClearSlotReleasesOnlyThatSlotsMappedBricks) {
+  const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
+  PageTable pt(h, 3);
+  std::vector<std::uint32_t> expect;
+  std::mt19937 gen(5);
+  auto rng = [&] { return std::uint32_t(gen()); };
+  std::uint32_t next_slot = 0;
+  for (std::uint32_t s = 0; s < 3; ++s)
+    for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+      const glm::uvec3 nb = h.level(l).bricks;
+      for (std::uint32_t i = 0; i < nb.x * nb.y * nb.z; i += 1 + rng() % 3) {
+        const PageAddress a{s, l, {i % nb.x, (i / nb.x) % nb.y, i / (nb.x * nb.y)}};
+        if (rng() % 2) {
+          pt.set_mapped(a, next_slot);
+          if (s == 1) expect.push_back(next_slot);
+          ++next_slot;
+        } else {
+          pt.set_empty(a);
+        }
+      }
+    }
+  pt.take_deltas();
+  const std::vector<std::uint32_t> other = pt.entries();
+  std::vector<std::uint32_t> got = pt.clear_slot(1);
+  std::sort(got.begin(), got.end());
+  EXPECT_EQ(got, expect);
+  const std::uint32_t lo = pt.table_offsets()[pt.table_id(1, 0)];
+  const std::uint32_t hi = pt.table_offsets()[pt.table_id(2, 0)];
+  for (std::uint32_t i = 0; i < pt.entries().size(); ++i) {
+    if (i >= lo && i < hi) {
+      EXPECT_EQ(pt.entries()[i], k::kPageUnmappedWord);
+    } else {
+      EXPECT_EQ(pt.entries()[i], other[i]);
+    }
+  }
+  for (const PageDelta& d : pt.take_deltas()) {
+    EXPECT_TRUE(d.index >= lo && d.index < hi);
+    EXPECT_NE(other[d.index], k::kPageUnmappedWord);
+    EXPECT_EQ(d.value, k::kPageUnmappedWord);
+  }
+}
+
+TEST(PageTable, DeviceKeysRoundTripAndForeignKeysAreRejected) {
+  const BrickHierarchy h = make({795, 3, 1}, glm::uvec3(8), 1);
+  PageTable pt(h, 2);
+  std::map<std::uint32_t, bool> seen;
+  for (std::uint32_t s = 0; s < 2; ++s)
+    for (std::uint32_t l = 0; l < h.level_count(); ++l)
+      for (std::uint32_t x = 0; x < h.level(l).bricks.x; ++x) {
+        const PageAddress a{s, l, {x, 0, 0}};
+        const std::uint32_t key = pt.device_key(a);
+        EXPECT_FALSE(seen[key]);
+        seen[key] = true;
+        EXPECT_EQ(pt.decode_device_key(key), a);
+      }
+  EXPECT_FALSE(pt.decode_device_key(k::kRequestKeyNone).has_value());
+  EXPECT_FALSE(pt.decode_device_key(k::request_key_encode(pt.table_count(), 0)).has_value());
+  EXPECT_FALSE(pt.decode_device_key(k::request_key_encode(0, std::uint32_t(h.level(0).brick_count)))
+                   .has_value());
+  EXPECT_RESOCT_ERROR(pt.device_key(PageAddress{0, 0, {100, 0, 0}}), ErrorCode::out_of_range,
+                      "outside level");
+}
+
+TEST(PageTable, RejectsHierarchiesThatDoNotFitDeviceKeys) {
+  const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
+  EXPECT_RESOCT_ERROR(PageTable(h, 0), ErrorCode::invalid_argument, "slots");
+  const std::uint32_t max_slots = k::kRequestMaxTables / h.level_count();
+  EXPECT_NO_THROW(PageTable(h, max_slots));
+  EXPECT_RESOCT_ERROR(PageTable(h, max_slots + 1), ErrorCode::invalid_argument,
+                      "too many page tables for 32-bit device keys");
+  // 2048^3 voxels in 4^3 bricks: 512^3 bricks at level 0, far beyond 2^25.
+  const BrickHierarchy big = make({2048, 2048, 2048}, glm::uvec3(4), 1);
+  EXPECT_RESOCT_ERROR(PageTable(big, 1), ErrorCode::invalid_argument,
+                      "too many bricks for 32-bit device keys");
+  // Exactly 2^25 - 1 = 18631 x 1801 bricks at level 0: the reserved local index is not allowed.
+  static_assert(18631ull * 1801ull == k::kRequestMaxBricksPerTable);
+  const BrickHierarchy edge = make({4ull * 18631, 4ull * 1801, 1}, glm::uvec3(4), 0);
+  EXPECT_RESOCT_ERROR(PageTable(edge, 1), ErrorCode::invalid_argument, "brick_size");
+}

@@ -1,0 +1,27 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Compiles the single-source kernel headers as GLSL and calls every encode/decode function so that
+// glslang type-checks them (unused functions are not checked in depth).
+#include "resoct/kernel/common.glsl.h"
+#include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/request_key.glsl.h"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) buffer Pages { uint pages[]; };
+layout(std430, binding = 1) buffer OutWords { uint words[]; };
+layout(std430, binding = 2) buffer OutValues { float values[]; };
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  uint e = pages[i];
+  uint acc = page_state(e) + page_payload(e) + page_cache_slot(e);
+  if (page_is_mapped(e) || page_is_constant(e)) acc += 1u;
+  acc += page_encode_mapped(i) ^ page_encode_homogeneous(i & 0xFFFFu) ^ kPageEmptyWord;
+  acc += page_local_index(uvec3(i, 1u, 2u), uvec3(64u, 4u, 4u));
+  uint key = request_key_encode(request_table_id(1u, 2u, 8u), i);
+  acc += request_key_table(key) + request_key_local(key) + request_key_hash(key, 12u);
+  if (key == kRequestKeyNone) acc = 0u;
+  words[i] = acc;
+  values[i] = page_homogeneous_value(e);
+}
