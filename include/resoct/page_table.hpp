@@ -39,11 +39,11 @@ struct PageLookup {
   glm::uvec3 voxel{0};            ///< level voxel, clamped to the level extent
   glm::uvec3 padded_offset{0};    ///< voxel within the padded brick: core offset + halo
 
-  bool mapped() const noexcept { return kernel::page_is_mapped(entry); }
+  bool mapped() const noexcept { return kernel::resoct_page_is_mapped(entry); }
   /// Cache slot of a MAPPED entry, nullopt otherwise.
   std::optional<std::uint32_t> cache_slot() const noexcept {
     if (!mapped()) return std::nullopt;
-    return kernel::page_cache_slot(entry);
+    return kernel::resoct_page_cache_slot(entry);
   }
 };
 

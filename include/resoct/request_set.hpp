@@ -30,13 +30,13 @@ struct RequestBatch {
   std::uint64_t dropped = 0;      ///< inserts refused because the set was full or probing gave up
 };
 
-/// Keys are 32-bit; kernel::kRequestKeyNone (all ones) marks a free slot and is refused. Brick and
-/// node (metadata) requests live in two separate sets, so their key spaces never mix: brick sets
-/// hold device request keys (kernel/request_key.glsl.h), node sets octree node indices.
+/// Keys are 32-bit; kernel::RESOCT_REQUEST_KEY_NONE (all ones) marks a free slot and is refused.
+/// Brick and node (metadata) requests live in two separate sets, so their key spaces never mix:
+/// brick sets hold device request keys (kernel/request_key.glsl.h), node sets octree node indices.
 ///
 /// Guarantees: a key is stored at most once; an insert either adds its hits to the key's count or
 /// is counted in dropped() (so sum of hits + dropped inserts = inserts of one hit each); a refused
-/// insert is never an error. Probing is linear from kernel::request_key_hash, at most
+/// insert is never an error. Probing is linear from kernel::resoct_request_key_hash, at most
 /// max_probes slots, so a GPU set built the same way behaves identically.
 /// Thread-safety: insert() is lock-free and may run on any number of threads at once; every other
 /// member must not overlap with insert() (call it between frames).
@@ -52,8 +52,9 @@ class RequestSet {
   std::uint32_t max_probes() const noexcept { return max_probes_; }
 
   /// Adds `hits` to key's count, inserting it if absent. False (and counted) when the set is
-  /// full, the probe bound is hit, or the key is the reserved kRequestKeyNone. Lock-free. Counts
-  /// are 32-bit and wrap past 2^32 - 1 hits in one frame: insert once per ray, not per sample.
+  /// full, the probe bound is hit, or the key is the reserved RESOCT_REQUEST_KEY_NONE. Lock-free.
+  /// Counts are 32-bit and wrap past 2^32 - 1 hits in one frame: insert once per ray, not per
+  /// sample.
   bool insert(std::uint32_t key, std::uint32_t hits = 1) noexcept;
 
   /// Distinct keys stored this frame.

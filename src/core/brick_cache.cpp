@@ -66,7 +66,7 @@ BrickCache::BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t 
                                                   std::to_string(slot_bytes_) + " bytes");
   }
   const std::uint64_t slots = capacity_bytes / slot_bytes_;
-  if (slots > std::uint64_t(kernel::kPageMaxCacheSlot) + 1u) {
+  if (slots > std::uint64_t(kernel::RESOCT_PAGE_MAX_CACHE_SLOT) + 1u) {
     throw invalid_parameter(
         "capacity_bytes", std::to_string(slots) + " slots exceed the 2^30 a page entry addresses");
   }

@@ -30,17 +30,17 @@ RequestSet::RequestSet(std::uint32_t capacity, std::uint32_t max_probes) {
                 "capacity: no host memory for a request set of " + std::to_string(cap) + " keys");
   }
   for (std::uint32_t i = 0; i < cap; ++i) {
-    keys_[i].store(k::kRequestKeyNone, std::memory_order_relaxed);
+    keys_[i].store(k::RESOCT_REQUEST_KEY_NONE, std::memory_order_relaxed);
     hits_[i].store(0, std::memory_order_relaxed);
   }
 }
 
 bool RequestSet::insert(std::uint32_t key, std::uint32_t hits) noexcept {
-  if (key != k::kRequestKeyNone) {
-    std::uint32_t i = k::request_key_hash(key, log2_capacity_);
+  if (key != k::RESOCT_REQUEST_KEY_NONE) {
+    std::uint32_t i = k::resoct_request_key_hash(key, log2_capacity_);
     for (std::uint32_t probe = 0; probe < max_probes_; ++probe, i = (i + 1u) & mask_) {
       std::uint32_t cur = keys_[i].load(std::memory_order_acquire);
-      if (cur == k::kRequestKeyNone) {
+      if (cur == k::RESOCT_REQUEST_KEY_NONE) {
         if (keys_[i].compare_exchange_strong(cur, key, std::memory_order_acq_rel,
                                              std::memory_order_acquire)) {
           // Slots only go from free to a key during a frame, so at most `capacity` claims
@@ -65,7 +65,7 @@ void RequestSet::clear() noexcept {
   const std::uint32_t n = filled_.load(std::memory_order_relaxed);
   for (std::uint32_t j = 0; j < n; ++j) {
     const std::uint32_t i = filled_slots_[j];
-    keys_[i].store(k::kRequestKeyNone, std::memory_order_relaxed);
+    keys_[i].store(k::RESOCT_REQUEST_KEY_NONE, std::memory_order_relaxed);
     hits_[i].store(0, std::memory_order_relaxed);
   }
   filled_.store(0, std::memory_order_relaxed);

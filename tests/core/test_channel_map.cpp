@@ -45,7 +45,7 @@ TEST(ChannelMap, KeysFromBeforeARemapOfTheirSlotAreDropped) {
   // Unassigned slot: nothing resolves.
   cm.assign(1, std::nullopt, pt);
   EXPECT_FALSE(cm.resolve(k1, cm.epoch(), pt).has_value());
-  EXPECT_FALSE(cm.resolve(k::kRequestKeyNone, cm.epoch(), pt).has_value());
+  EXPECT_FALSE(cm.resolve(k::RESOCT_REQUEST_KEY_NONE, cm.epoch(), pt).has_value());
   EXPECT_RESOCT_ERROR(cm.resolve(k0, cm.epoch() + 1, pt), ErrorCode::out_of_range, "epoch");
 }
 
@@ -63,9 +63,9 @@ TEST(ChannelMap, RemapClearsTheSlotsTablesAndReportsCacheSlots) {
   SlotRemap r = cm.assign(0, 2, pt);
   std::sort(r.released_cache_slots.begin(), r.released_cache_slots.end());
   EXPECT_EQ(r.released_cache_slots, (std::vector<std::uint32_t>{10, 11}));
-  EXPECT_EQ(pt.entry({0, 0, {1, 1, 1}}), k::kPageUnmappedWord);
-  EXPECT_EQ(pt.entry({0, 1, {0, 0, 0}}), k::kPageUnmappedWord);
-  EXPECT_EQ(pt.entry({1, 0, {1, 1, 1}}), k::page_encode_mapped(12));
+  EXPECT_EQ(pt.entry({0, 0, {1, 1, 1}}), k::RESOCT_PAGE_UNMAPPED_WORD);
+  EXPECT_EQ(pt.entry({0, 1, {0, 0, 0}}), k::RESOCT_PAGE_UNMAPPED_WORD);
+  EXPECT_EQ(pt.entry({1, 0, {1, 1, 1}}), k::resoct_page_encode_mapped(12));
   EXPECT_EQ(pt.take_deltas().size(), 3u);
   // Re-assigning the same channel changes nothing.
   const std::uint64_t e = cm.epoch();
@@ -73,7 +73,7 @@ TEST(ChannelMap, RemapClearsTheSlotsTablesAndReportsCacheSlots) {
   r = cm.assign(0, 2, pt);
   EXPECT_TRUE(r.released_cache_slots.empty());
   EXPECT_EQ(cm.epoch(), e);
-  EXPECT_EQ(pt.entry({0, 0, {0, 0, 0}}), k::page_encode_mapped(13));
+  EXPECT_EQ(pt.entry({0, 0, {0, 0, 0}}), k::resoct_page_encode_mapped(13));
 }
 
 TEST(ChannelMap, LookupsBothWaysAndErrors) {
@@ -113,8 +113,8 @@ TEST(ChannelMap, ResolvesADrainedBatchAndCountsStaleRequests) {
   rs.insert(pt.device_key(a), 5);
   rs.insert(pt.device_key(b), 9);
   rs.insert(pt.device_key(c), 2);
-  rs.insert(k::request_key_encode(pt.table_count(), 0));  // garbage from the device
-  cm.assign(1, 2, pt);                                    // slot 1 remapped after recording
+  rs.insert(k::resoct_request_key_encode(pt.table_count(), 0));  // garbage from the device
+  cm.assign(1, 2, pt);                                           // slot 1 remapped after recording
   const RequestBatch batch = rs.drain([&](std::uint32_t key) {
     const auto d = pt.decode_device_key(key);
     return d ? d->level : 0u;

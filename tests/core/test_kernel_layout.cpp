@@ -13,61 +13,63 @@
 using namespace resoct;
 namespace k = resoct::kernel;
 
-static_assert(k::kPagePayloadMask == (1u << k::kPageStateShift) - 1u);
-static_assert(k::kPageMaxCacheSlot == k::kPagePayloadMask);
-static_assert(k::kPageUnmappedWord == 0u, "a zero-filled buffer must be an unmapped table");
-static_assert(k::kPageEmptyWord == k::kPageStateEmpty << k::kPageStateShift);
-static_assert(k::kPageStateHomogeneous == 3u &&
-              (3u << k::kPageStateShift) >> k::kPageStateShift == 3u);
-static_assert(k::kRequestBrickBits + k::kRequestTableBits == 32u);
-static_assert(k::kRequestMaxTables == 1u << k::kRequestTableBits);
-static_assert(k::kRequestBrickMask == (1u << k::kRequestBrickBits) - 1u);
-static_assert(k::kRequestMaxBricksPerTable == k::kRequestBrickMask);
+static_assert(k::RESOCT_PAGE_PAYLOAD_MASK == (1u << k::RESOCT_PAGE_STATE_SHIFT) - 1u);
+static_assert(k::RESOCT_PAGE_MAX_CACHE_SLOT == k::RESOCT_PAGE_PAYLOAD_MASK);
+static_assert(k::RESOCT_PAGE_UNMAPPED_WORD == 0u, "a zero-filled buffer must be an unmapped table");
+static_assert(k::RESOCT_PAGE_EMPTY_WORD == k::RESOCT_PAGE_STATE_EMPTY
+                                               << k::RESOCT_PAGE_STATE_SHIFT);
+static_assert(k::RESOCT_PAGE_STATE_HOMOGENEOUS == 3u &&
+              (3u << k::RESOCT_PAGE_STATE_SHIFT) >> k::RESOCT_PAGE_STATE_SHIFT == 3u);
+static_assert(k::RESOCT_REQUEST_BRICK_BITS + k::RESOCT_REQUEST_TABLE_BITS == 32u);
+static_assert(k::RESOCT_REQUEST_MAX_TABLES == 1u << k::RESOCT_REQUEST_TABLE_BITS);
+static_assert(k::RESOCT_REQUEST_BRICK_MASK == (1u << k::RESOCT_REQUEST_BRICK_BITS) - 1u);
+static_assert(k::RESOCT_REQUEST_MAX_BRICKS_PER_TABLE == k::RESOCT_REQUEST_BRICK_MASK);
 static_assert(sizeof(k::uint) == 4u);
 // Deltas go to device buffers as (index, value) word pairs.
 static_assert(sizeof(PageDelta) == 8u && offsetof(PageDelta, value) == 4u);
 
 TEST(KernelLayout, PageEntryRoundTripsAtLimits) {
-  for (std::uint32_t slot : {0u, 1u, 12345u, k::kPageMaxCacheSlot - 1u, k::kPageMaxCacheSlot}) {
-    const std::uint32_t e = k::page_encode_mapped(slot);
-    EXPECT_EQ(k::page_state(e), k::kPageStateMapped);
-    EXPECT_TRUE(k::page_is_mapped(e));
-    EXPECT_FALSE(k::page_is_constant(e));
-    EXPECT_EQ(k::page_cache_slot(e), slot);
-    EXPECT_EQ(k::page_payload(e), slot);
+  for (std::uint32_t slot :
+       {0u, 1u, 12345u, k::RESOCT_PAGE_MAX_CACHE_SLOT - 1u, k::RESOCT_PAGE_MAX_CACHE_SLOT}) {
+    const std::uint32_t e = k::resoct_page_encode_mapped(slot);
+    EXPECT_EQ(k::resoct_page_state(e), k::RESOCT_PAGE_STATE_MAPPED);
+    EXPECT_TRUE(k::resoct_page_is_mapped(e));
+    EXPECT_FALSE(k::resoct_page_is_constant(e));
+    EXPECT_EQ(k::resoct_page_cache_slot(e), slot);
+    EXPECT_EQ(k::resoct_page_payload(e), slot);
   }
   for (std::uint32_t v : {0u, 1u, 32768u, 65534u, 65535u}) {
-    const std::uint32_t e = k::page_encode_homogeneous(v);
-    EXPECT_EQ(k::page_state(e), k::kPageStateHomogeneous);
-    EXPECT_TRUE(k::page_is_constant(e));
-    EXPECT_FALSE(k::page_is_mapped(e));
-    EXPECT_EQ(k::page_payload(e), v);
-    EXPECT_FLOAT_EQ(k::page_homogeneous_value(e), float(v) / 65535.0f);
+    const std::uint32_t e = k::resoct_page_encode_homogeneous(v);
+    EXPECT_EQ(k::resoct_page_state(e), k::RESOCT_PAGE_STATE_HOMOGENEOUS);
+    EXPECT_TRUE(k::resoct_page_is_constant(e));
+    EXPECT_FALSE(k::resoct_page_is_mapped(e));
+    EXPECT_EQ(k::resoct_page_payload(e), v);
+    EXPECT_FLOAT_EQ(k::resoct_page_homogeneous_value(e), float(v) / 65535.0f);
   }
-  EXPECT_EQ(k::page_state(k::kPageUnmappedWord), k::kPageStateUnmapped);
-  EXPECT_FALSE(k::page_is_constant(k::kPageUnmappedWord));
-  EXPECT_EQ(k::page_state(k::kPageEmptyWord), k::kPageStateEmpty);
-  EXPECT_TRUE(k::page_is_constant(k::kPageEmptyWord));
-  EXPECT_EQ(k::page_homogeneous_value(k::kPageEmptyWord), 0.0f);
+  EXPECT_EQ(k::resoct_page_state(k::RESOCT_PAGE_UNMAPPED_WORD), k::RESOCT_PAGE_STATE_UNMAPPED);
+  EXPECT_FALSE(k::resoct_page_is_constant(k::RESOCT_PAGE_UNMAPPED_WORD));
+  EXPECT_EQ(k::resoct_page_state(k::RESOCT_PAGE_EMPTY_WORD), k::RESOCT_PAGE_STATE_EMPTY);
+  EXPECT_TRUE(k::resoct_page_is_constant(k::RESOCT_PAGE_EMPTY_WORD));
+  EXPECT_EQ(k::resoct_page_homogeneous_value(k::RESOCT_PAGE_EMPTY_WORD), 0.0f);
   // The four states are distinct words even with payload 0.
-  EXPECT_NE(k::page_encode_mapped(0), k::kPageUnmappedWord);
-  EXPECT_NE(k::page_encode_homogeneous(0), k::kPageEmptyWord);
+  EXPECT_NE(k::resoct_page_encode_mapped(0), k::RESOCT_PAGE_UNMAPPED_WORD);
+  EXPECT_NE(k::resoct_page_encode_homogeneous(0), k::RESOCT_PAGE_EMPTY_WORD);
 }
 
 TEST(KernelLayout, RequestKeyRoundTripsAtLimits) {
-  for (std::uint32_t t : {0u, 1u, 63u, k::kRequestMaxTables - 1u}) {
-    for (std::uint32_t local : {0u, 1u, 0x00ABCDEFu, k::kRequestMaxBricksPerTable - 1u}) {
-      const std::uint32_t key = k::request_key_encode(t, local);
-      EXPECT_EQ(k::request_key_table(key), t);
-      EXPECT_EQ(k::request_key_local(key), local);
-      EXPECT_NE(key, k::kRequestKeyNone);
+  for (std::uint32_t t : {0u, 1u, 63u, k::RESOCT_REQUEST_MAX_TABLES - 1u}) {
+    for (std::uint32_t local : {0u, 1u, 0x00ABCDEFu, k::RESOCT_REQUEST_MAX_BRICKS_PER_TABLE - 1u}) {
+      const std::uint32_t key = k::resoct_request_key_encode(t, local);
+      EXPECT_EQ(k::resoct_request_key_table(key), t);
+      EXPECT_EQ(k::resoct_request_key_local(key), local);
+      EXPECT_NE(key, k::RESOCT_REQUEST_KEY_NONE);
     }
   }
-  EXPECT_EQ(k::request_table_id(3u, 5u, 9u), 3u * 9u + 5u);
+  EXPECT_EQ(k::resoct_request_table_id(3u, 5u, 9u), 3u * 9u + 5u);
   std::mt19937 rng(7);
   for (std::uint32_t log2 : {0u, 1u, 10u, 20u, 28u}) {
     for (int i = 0; i < 1000; ++i) {
-      EXPECT_LT(k::request_key_hash(std::uint32_t(rng()), log2), 1ull << log2);
+      EXPECT_LT(k::resoct_request_key_hash(std::uint32_t(rng()), log2), 1ull << log2);
     }
   }
 }
@@ -82,7 +84,7 @@ TEST(KernelLayout, PageLocalIndexMatchesHierarchyLinearIndex) {
       for (std::uint32_t y = 0; y < li.bricks.y; ++y)
         for (std::uint32_t x = 0; x < li.bricks.x; ++x) {
           const glm::uvec3 b(x, y, z);
-          EXPECT_EQ(std::uint64_t(k::page_local_index(b, li.bricks)) + li.first_brick,
+          EXPECT_EQ(std::uint64_t(k::resoct_page_local_index(b, li.bricks)) + li.first_brick,
                     h.linear_index(l, b));
         }
   }
@@ -96,15 +98,16 @@ TEST(KernelLayout, HostKeysAndEntriesUseTheKernelEncoding) {
   PageTable pt(h, 3);
   const PageAddress a{2, 1, glm::uvec3(17, 0, 0)};
   const std::uint32_t key = pt.device_key(a);
-  EXPECT_EQ(k::request_key_table(key), 2u * h.level_count() + 1u);
-  EXPECT_EQ(k::request_key_local(key), 17u);
-  pt.set_mapped(a, k::kPageMaxCacheSlot);
-  EXPECT_EQ(pt.entry(a), k::page_encode_mapped(k::kPageMaxCacheSlot));
-  EXPECT_EQ(pt.entries()[pt.table_offsets()[k::request_key_table(key)] + 17u], pt.entry(a));
+  EXPECT_EQ(k::resoct_request_key_table(key), 2u * h.level_count() + 1u);
+  EXPECT_EQ(k::resoct_request_key_local(key), 17u);
+  pt.set_mapped(a, k::RESOCT_PAGE_MAX_CACHE_SLOT);
+  EXPECT_EQ(pt.entry(a), k::resoct_page_encode_mapped(k::RESOCT_PAGE_MAX_CACHE_SLOT));
+  EXPECT_EQ(pt.entries()[pt.table_offsets()[k::resoct_request_key_table(key)] + 17u], pt.entry(a));
   // A cache cannot hand out a slot the entry cannot hold: 2^30 slots is its limit (checked before
   // anything is allocated).
   const BrickLayout small{glm::uvec3(4), 0};
   const std::uint64_t slot_bytes = small.padded_voxels();
-  EXPECT_RESOCT_ERROR(BrickCache(small, VoxelType::u8, slot_bytes * (k::kPageMaxCacheSlot + 2ull)),
-                      ErrorCode::invalid_argument, "capacity_bytes");
+  EXPECT_RESOCT_ERROR(
+      BrickCache(small, VoxelType::u8, slot_bytes * (k::RESOCT_PAGE_MAX_CACHE_SLOT + 2ull)),
+      ErrorCode::invalid_argument, "capacity_bytes");
 }

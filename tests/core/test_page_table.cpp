@@ -87,7 +87,7 @@ void check_every_voxel(const BrickHierarchy& h, std::uint32_t slots) {
           ASSERT_EQ(glm::u64vec3(r.brick), br);
           ASSERT_EQ(glm::u64vec3(r.padded_offset), off);
           ASSERT_EQ(r.entry_index, idx);
-          ASSERT_EQ(r.entry, k::page_encode_mapped(std::uint32_t(idx) * 7u + 1u));
+          ASSERT_EQ(r.entry, k::resoct_page_encode_mapped(std::uint32_t(idx) * 7u + 1u));
           ASSERT_EQ(r.cache_slot(), std::uint32_t(idx) * 7u + 1u);
           ++checked;
         }
@@ -175,14 +175,14 @@ TEST(PageTable, HomogeneousKeepsTheExactValueOnTheHost) {
   PageTable pt(h, 1);
   const PageAddress a{0, 0, {1, 2, 0}}, b{0, 1, {0, 0, 0}};
   pt.set_homogeneous(a, 1234.0, ValueRange{0, 65535});  // u16, default range: exact in unorm16
-  EXPECT_EQ(pt.entry(a), k::page_encode_homogeneous(1234u));
+  EXPECT_EQ(pt.entry(a), k::resoct_page_encode_homogeneous(1234u));
   EXPECT_EQ(pt.homogeneous_value(a), 1234.0);
   const double f = 0.123456789012345;  // f32 data: the device sees the rounded unorm16
   pt.set_homogeneous(b, f, ValueRange{0, 1});
-  EXPECT_EQ(k::page_payload(pt.entry(b)), std::uint32_t(std::lround(f * 65535.0)));
+  EXPECT_EQ(k::resoct_page_payload(pt.entry(b)), std::uint32_t(std::lround(f * 65535.0)));
   EXPECT_EQ(pt.homogeneous_value(b), f);
   pt.set_homogeneous(b, 7.5, ValueRange{0, 1});  // outside the range: clamped on the device only
-  EXPECT_EQ(k::page_payload(pt.entry(b)), 65535u);
+  EXPECT_EQ(k::resoct_page_payload(pt.entry(b)), 65535u);
   EXPECT_EQ(pt.homogeneous_value(b), 7.5);
   pt.set_mapped(b, 3);
   EXPECT_FALSE(pt.homogeneous_value(b).has_value());
@@ -220,15 +220,15 @@ TEST(PageTable, ClearSlotReleasesOnlyThatSlotsMappedBricks) {
   const std::uint32_t hi = pt.table_offsets()[pt.table_id(2, 0)];
   for (std::uint32_t i = 0; i < pt.entries().size(); ++i) {
     if (i >= lo && i < hi) {
-      EXPECT_EQ(pt.entries()[i], k::kPageUnmappedWord);
+      EXPECT_EQ(pt.entries()[i], k::RESOCT_PAGE_UNMAPPED_WORD);
     } else {
       EXPECT_EQ(pt.entries()[i], other[i]);
     }
   }
   for (const PageDelta& d : pt.take_deltas()) {
     EXPECT_TRUE(d.index >= lo && d.index < hi);
-    EXPECT_NE(other[d.index], k::kPageUnmappedWord);
-    EXPECT_EQ(d.value, k::kPageUnmappedWord);
+    EXPECT_NE(other[d.index], k::RESOCT_PAGE_UNMAPPED_WORD);
+    EXPECT_EQ(d.value, k::RESOCT_PAGE_UNMAPPED_WORD);
   }
 }
 
@@ -245,10 +245,11 @@ TEST(PageTable, DeviceKeysRoundTripAndForeignKeysAreRejected) {
         seen[key] = true;
         EXPECT_EQ(pt.decode_device_key(key), a);
       }
-  EXPECT_FALSE(pt.decode_device_key(k::kRequestKeyNone).has_value());
-  EXPECT_FALSE(pt.decode_device_key(k::request_key_encode(pt.table_count(), 0)).has_value());
-  EXPECT_FALSE(pt.decode_device_key(k::request_key_encode(0, std::uint32_t(h.level(0).brick_count)))
-                   .has_value());
+  EXPECT_FALSE(pt.decode_device_key(k::RESOCT_REQUEST_KEY_NONE).has_value());
+  EXPECT_FALSE(pt.decode_device_key(k::resoct_request_key_encode(pt.table_count(), 0)).has_value());
+  EXPECT_FALSE(
+      pt.decode_device_key(k::resoct_request_key_encode(0, std::uint32_t(h.level(0).brick_count)))
+          .has_value());
   EXPECT_RESOCT_ERROR(pt.device_key(PageAddress{0, 0, {100, 0, 0}}), ErrorCode::out_of_range,
                       "outside level");
 }
@@ -256,7 +257,7 @@ TEST(PageTable, DeviceKeysRoundTripAndForeignKeysAreRejected) {
 TEST(PageTable, RejectsHierarchiesThatDoNotFitDeviceKeys) {
   const BrickHierarchy h = make({40, 33, 17}, glm::uvec3(8), 1);
   EXPECT_RESOCT_ERROR(PageTable(h, 0), ErrorCode::invalid_argument, "slots");
-  const std::uint32_t max_slots = k::kRequestMaxTables / h.level_count();
+  const std::uint32_t max_slots = k::RESOCT_REQUEST_MAX_TABLES / h.level_count();
   EXPECT_NO_THROW(PageTable(h, max_slots));
   EXPECT_RESOCT_ERROR(PageTable(h, max_slots + 1), ErrorCode::invalid_argument,
                       "too many page tables for 32-bit device keys");
@@ -265,7 +266,7 @@ TEST(PageTable, RejectsHierarchiesThatDoNotFitDeviceKeys) {
   EXPECT_RESOCT_ERROR(PageTable(big, 1), ErrorCode::invalid_argument,
                       "too many bricks for 32-bit device keys");
   // Exactly 2^25 - 1 = 18631 x 1801 bricks at level 0: the reserved local index is not allowed.
-  static_assert(18631ull * 1801ull == k::kRequestMaxBricksPerTable);
+  static_assert(18631ull * 1801ull == k::RESOCT_REQUEST_MAX_BRICKS_PER_TABLE);
   const BrickHierarchy edge = make({4ull * 18631, 4ull * 1801, 1}, glm::uvec3(4), 0);
   EXPECT_RESOCT_ERROR(PageTable(edge, 1), ErrorCode::invalid_argument, "brick_size");
 }

@@ -39,8 +39,8 @@ TEST(RequestSet, OverflowIsCountedExactly) {
   for (std::uint32_t key = 0; key < 20; ++key) EXPECT_EQ(rs.insert(key * 3u), key < 8);
   EXPECT_EQ(rs.size(), 8u);
   EXPECT_EQ(rs.dropped(), 12u);
-  EXPECT_TRUE(rs.insert(0));                    // stored keys still count hits when full
-  EXPECT_FALSE(rs.insert(k::kRequestKeyNone));  // reserved: refused and counted
+  EXPECT_TRUE(rs.insert(0));                            // stored keys still count hits when full
+  EXPECT_FALSE(rs.insert(k::RESOCT_REQUEST_KEY_NONE));  // reserved: refused and counted
   const RequestBatch b = rs.drain();
   EXPECT_EQ(b.dropped, 13u);
   ASSERT_EQ(b.requests.size(), 8u);
@@ -56,7 +56,7 @@ TEST(RequestSet, ProbeBoundDropsCollidingKeys) {
   std::vector<std::uint32_t> same;
   std::uint32_t home = 0;
   for (std::uint32_t key = 0; same.size() < 4; ++key) {
-    const std::uint32_t h = k::request_key_hash(key, log2);
+    const std::uint32_t h = k::resoct_request_key_hash(key, log2);
     if (same.empty()) home = h;
     if (h == home) same.push_back(key);
   }

@@ -15,13 +15,13 @@ layout(std430, binding = 2) buffer OutValues { float values[]; };
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint e = pages[i];
-  uint acc = page_state(e) + page_payload(e) + page_cache_slot(e);
-  if (page_is_mapped(e) || page_is_constant(e)) acc += 1u;
-  acc += page_encode_mapped(i) ^ page_encode_homogeneous(i & 0xFFFFu) ^ kPageEmptyWord;
-  acc += page_local_index(uvec3(i, 1u, 2u), uvec3(64u, 4u, 4u));
-  uint key = request_key_encode(request_table_id(1u, 2u, 8u), i);
-  acc += request_key_table(key) + request_key_local(key) + request_key_hash(key, 12u);
-  if (key == kRequestKeyNone) acc = 0u;
+  uint acc = resoct_page_state(e) + resoct_page_payload(e) + resoct_page_cache_slot(e);
+  if (resoct_page_is_mapped(e) || resoct_page_is_constant(e)) acc += 1u;
+  acc += resoct_page_encode_mapped(i) ^ resoct_page_encode_homogeneous(i & 0xFFFFu) ^ RESOCT_PAGE_EMPTY_WORD;
+  acc += resoct_page_local_index(uvec3(i, 1u, 2u), uvec3(64u, 4u, 4u));
+  uint key = resoct_request_key_encode(resoct_request_table_id(1u, 2u, 8u), i);
+  acc += resoct_request_key_table(key) + resoct_request_key_local(key) + resoct_request_key_hash(key, 12u);
+  if (key == RESOCT_REQUEST_KEY_NONE) acc = 0u;
   words[i] = acc;
-  values[i] = page_homogeneous_value(e);
+  values[i] = resoct_page_homogeneous_value(e);
 }

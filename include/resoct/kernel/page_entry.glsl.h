@@ -3,7 +3,7 @@
 // Layout of an entry (std430-safe: a plain uint in a storage buffer):
 //   bits 30-31  state: UNMAPPED (0), MAPPED (1), EMPTY (2), HOMOGENEOUS (3)
 //   bits  0-29  payload:
-//               MAPPED       cache slot index, 0 .. kPageMaxCacheSlot
+//               MAPPED       cache slot index, 0 .. RESOCT_PAGE_MAX_CACHE_SLOT
 //               EMPTY        0 (the brick is constant zero: transparent for every transfer
 //               function) HOMOGENEOUS  bits 0-15 the constant value as unorm16 of the channel's
 //               value range,
@@ -21,55 +21,57 @@
 
 RESOCT_KERNEL_BEGIN
 
-RESOCT_CONST(uint, kPageStateShift, 30u);
-RESOCT_CONST(uint, kPagePayloadMask, 0x3FFFFFFFu);
-RESOCT_CONST(uint, kPageStateUnmapped, 0u);
-RESOCT_CONST(uint, kPageStateMapped, 1u);
-RESOCT_CONST(uint, kPageStateEmpty, 2u);
-RESOCT_CONST(uint, kPageStateHomogeneous, 3u);
+RESOCT_CONST(uint, RESOCT_PAGE_STATE_SHIFT, 30u);
+RESOCT_CONST(uint, RESOCT_PAGE_PAYLOAD_MASK, 0x3FFFFFFFu);
+RESOCT_CONST(uint, RESOCT_PAGE_STATE_UNMAPPED, 0u);
+RESOCT_CONST(uint, RESOCT_PAGE_STATE_MAPPED, 1u);
+RESOCT_CONST(uint, RESOCT_PAGE_STATE_EMPTY, 2u);
+RESOCT_CONST(uint, RESOCT_PAGE_STATE_HOMOGENEOUS, 3u);
 // Largest cache slot index a MAPPED entry can hold (2^30 - 1, ~1 G bricks).
-RESOCT_CONST(uint, kPageMaxCacheSlot, 0x3FFFFFFFu);
-RESOCT_CONST(uint, kPageHomogeneousMask, 0xFFFFu);
-RESOCT_CONST(uint, kPageUnmappedWord, 0u);
-RESOCT_CONST(uint, kPageEmptyWord, 0x80000000u);
+RESOCT_CONST(uint, RESOCT_PAGE_MAX_CACHE_SLOT, 0x3FFFFFFFu);
+RESOCT_CONST(uint, RESOCT_PAGE_HOMOGENEOUS_MASK, 0xFFFFu);
+RESOCT_CONST(uint, RESOCT_PAGE_UNMAPPED_WORD, 0u);
+RESOCT_CONST(uint, RESOCT_PAGE_EMPTY_WORD, 0x80000000u);
 
-RESOCT_FN uint page_state(uint entry) {
-  return entry >> kPageStateShift;
+RESOCT_FN uint resoct_page_state(uint entry) {
+  return entry >> RESOCT_PAGE_STATE_SHIFT;
 }
 
-RESOCT_FN uint page_payload(uint entry) {
-  return entry & kPagePayloadMask;
+RESOCT_FN uint resoct_page_payload(uint entry) {
+  return entry & RESOCT_PAGE_PAYLOAD_MASK;
 }
 
-RESOCT_FN uint page_encode_mapped(uint cache_slot) {
-  return (kPageStateMapped << kPageStateShift) | (cache_slot & kPagePayloadMask);
+RESOCT_FN uint resoct_page_encode_mapped(uint cache_slot) {
+  return (RESOCT_PAGE_STATE_MAPPED << RESOCT_PAGE_STATE_SHIFT) |
+         (cache_slot & RESOCT_PAGE_PAYLOAD_MASK);
 }
 
-RESOCT_FN uint page_encode_homogeneous(uint unorm16) {
-  return (kPageStateHomogeneous << kPageStateShift) | (unorm16 & kPageHomogeneousMask);
+RESOCT_FN uint resoct_page_encode_homogeneous(uint unorm16) {
+  return (RESOCT_PAGE_STATE_HOMOGENEOUS << RESOCT_PAGE_STATE_SHIFT) |
+         (unorm16 & RESOCT_PAGE_HOMOGENEOUS_MASK);
 }
 
-RESOCT_FN bool page_is_mapped(uint entry) {
-  return page_state(entry) == kPageStateMapped;
+RESOCT_FN bool resoct_page_is_mapped(uint entry) {
+  return resoct_page_state(entry) == RESOCT_PAGE_STATE_MAPPED;
 }
 
 // Cache slot of a MAPPED entry (meaningless for other states).
-RESOCT_FN uint page_cache_slot(uint entry) {
-  return entry & kPagePayloadMask;
+RESOCT_FN uint resoct_page_cache_slot(uint entry) {
+  return entry & RESOCT_PAGE_PAYLOAD_MASK;
 }
 
 // Normalised [0, 1] value of a HOMOGENEOUS entry; EMPTY reads as 0.
-RESOCT_FN float page_homogeneous_value(uint entry) {
-  return float(entry & kPageHomogeneousMask) / 65535.0f;
+RESOCT_FN float resoct_page_homogeneous_value(uint entry) {
+  return float(entry & RESOCT_PAGE_HOMOGENEOUS_MASK) / 65535.0f;
 }
 
 // True when the entry needs no brick access: EMPTY or HOMOGENEOUS.
-RESOCT_FN bool page_is_constant(uint entry) {
-  return page_state(entry) >= kPageStateEmpty;
+RESOCT_FN bool resoct_page_is_constant(uint entry) {
+  return resoct_page_state(entry) >= RESOCT_PAGE_STATE_EMPTY;
 }
 
 // Index of a brick within one (slot, level) table: x fastest, as BrickHierarchy::linear_index.
-RESOCT_FN uint page_local_index(uvec3 brick, uvec3 bricks) {
+RESOCT_FN uint resoct_page_local_index(uvec3 brick, uvec3 bricks) {
   return brick.x + bricks.x * (brick.y + bricks.y * brick.z);
 }
 
