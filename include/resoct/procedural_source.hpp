@@ -1,0 +1,106 @@
+#pragma once
+/// \file
+/// Virtual volumes computed on demand: nothing is materialized, so a 65536³ volume is described
+/// and any brick read in memory proportional to one brick.
+///
+/// Spec: `procedural:NAME[:WxHxD[:CHANNELS]]` (the prefix is required). Datasets (all seeded and
+/// deterministic: the same spec gives the same bytes on every run and platform):
+/// | NAME       | type | default size       | channels | content                                  |
+/// |------------|------|--------------------|----------|------------------------------------------|
+/// | tubes      | u8   | 256³               | 1..16    | sparse branching tube network, ~all 0    |
+/// | noisefloor | u8   | 256³               | 1..16    | blobs on a floor of 8..13 (never 0)      |
+/// | turbulence | u8   | 256³               | 1..16    | dense fractal value-noise turbulence     |
+/// | mandelbulb | u8   | 256³               | 1..16    | shell around the power-8 Mandelbulb      |
+/// | cells      | u16  | 1024×1024×40       | 16..32   | slab of cells, one marker per channel    |
+/// | constant   | f32  | 64³                | 1..16    | 0.5 everywhere                           |
+/// | ramp       | f32  | 64³                | 1..16    | voxel x holds (x + 0.5) / W (channel c:  |
+/// |            |      |                    |          | axis c % 3 instead of x)                 |
+/// | sphere     | f32  | 64³                | 1..16    | max(0, 1 - r / R), r = distance of the   |
+/// |            |      |                    |          | voxel centre from the volume centre, R = |
+/// |            |      |                    |          | half the smallest extent                 |
+/// Values use the type's default range (u8 0..255, u16 0..65535, f32 0..1). Integer datasets
+/// store round(v * max) of a field v in [0, 1].
+///
+/// Coarser levels. Level l voxels follow the box filter of downsample.hpp:
+/// - when every axis has factor_log2 <= 2 (footprint <= 4 voxels per axis) they are computed
+///   exactly: level-0 voxels of the footprint, downsampled level by level as the hierarchy does;
+/// - otherwise each footprint axis is cut into 2^min(f, 2) sub-intervals (the recursive children
+///   at factor g = f - min(f, 2), clamped to the volume, with the recursive filter's weights) and
+///   the field is sampled once at each sub-interval's centre (the mean of its voxel centres); the
+///   weighted mean is rounded once.
+/// Error bound (coarse_error_bound): against exact recursive downsampling of the stored level 0,
+///   |error| <= L * D + Q, with L the field's Lipschitz constant (value units per level-0
+///   voxel), D = sqrt(sum_a ((2^g_a - 1) / 2)^2) the farthest a voxel centre lies from the sample
+///   standing for it, and Q = 0.5 * (l + 2) for integer types (level-0 rounding, l rounding
+///   steps of the reference, the final rounding) or 1e-6 * (l + 2) for f32. Exact levels have
+///   bound 0. ramp and constant are linear, so their samples are exact and the bound reduces to
+///   Q-size float rounding; mandelbulb has no known Lipschitz constant (bound = +infinity), its
+///   observed error is reported by the tests.
+///
+/// region_meta is conservative for level-0 voxels: each dataset bounds its field over a box
+/// analytically (distance to tube segments, blobs and cells; Lipschitz bounds for turbulence; the
+/// Mandelbulb's bounding sphere), refined by splitting the region into up to 64 boxes; occupancy
+/// is the union of occupancy_span() of those boxes.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "resoct/brick_source.hpp"
+#include "resoct/procedural/field.hpp"
+
+namespace resoct {
+
+/// A parsed procedural spec.
+struct ProceduralSpec {
+  std::string name;
+  glm::u64vec3 extent{0};
+  std::uint32_t channels = 0;
+  VoxelType type = VoxelType::u8;
+};
+
+/// Parses `procedural:NAME[:WxHxD[:CHANNELS]]`, filling defaults. Throws
+/// Error(invalid_argument) naming "spec" (missing prefix, unknown name, malformed or zero size,
+/// trailing fields) or "channels" (outside the dataset's range).
+ProceduralSpec parse_procedural_spec(std::string_view spec);
+
+/// A BrickSource over one procedural field. Immutable; all members are thread-safe.
+class ProceduralSource : public BrickSource {
+ public:
+  /// Throws Error as parse_procedural_spec, or when the layout or hierarchy is invalid.
+  explicit ProceduralSource(std::string_view spec, BrickLayout layout = {});
+
+  const BrickHierarchy& hierarchy() const override { return hierarchy_; }
+  void read_brick(BrickKey key, std::span<std::byte> out) const override;
+  RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
+  std::string name() const override { return name_; }
+
+  const ProceduralSpec& spec() const noexcept { return spec_; }
+  const procedural::Field& field() const noexcept { return *field_; }
+  /// True when level l is computed exactly from level-0 voxels (every factor_log2 <= 2).
+  bool exact_level(std::uint32_t level) const;
+  /// The documented bound (see file comment) on |level-l voxel - exact recursive downsampling of
+  /// level 0|, in stored value units. 0 for exact levels.
+  double coarse_error_bound(std::uint32_t level, std::uint32_t channel) const;
+
+  /// Voxels of `box` (inside level `level`) of one channel, dense, x fastest.
+  void read_region(std::uint32_t level, std::uint32_t channel, const Box3& box,
+                   std::span<std::byte> out) const;
+
+ private:
+  void read_level0(std::uint32_t channel, const Box3& box, std::span<std::byte> out) const;
+  void read_approximate(std::uint32_t level, std::uint32_t channel, const Box3& box,
+                        std::span<std::byte> out) const;
+
+  ProceduralSpec spec_;
+  std::string name_;
+  std::unique_ptr<procedural::Field> field_;
+  BrickHierarchy hierarchy_;
+};
+
+/// Builds a ProceduralSource (see the spec grammar above).
+std::unique_ptr<BrickSource> make_procedural_source(std::string_view spec, BrickLayout layout = {});
+
+}  // namespace resoct

@@ -1,0 +1,146 @@
+// Dense procedural fields: "turbulence" (fractal value-noise fBm) and "mandelbulb" (a shell
+// around the power-8 Mandelbulb from its distance estimate).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "resoct/procedural/field.hpp"
+#include "resoct/procedural/math.hpp"
+
+namespace resoct::procedural {
+
+namespace {
+
+// v = clamp(0.5 + kContrast * fbm / sum(a), 0, 1) with fbm = sum_o a_o (2 n(F_o q) - 1).
+class TurbulenceField final : public Field {
+ public:
+  static constexpr int kOctaves = 4;
+  static constexpr double kBaseFreq = 2.0;  // lattice cells per normalized unit
+  static constexpr double kContrast = 0.9;
+
+  explicit TurbulenceField(const glm::u64vec3& extent)
+      : scale_(1.0 / double(std::max({extent.x, extent.y, extent.z}))) {
+    double amp = 1.0, freq = kBaseFreq, sum = 0.0, slope = 0.0;
+    for (int o = 0; o < kOctaves; ++o) {
+      sum += amp;
+      slope += amp * 2.0 * freq * kValueNoiseLipschitz;
+      amp *= 0.5;
+      freq *= 2.0;
+    }
+    norm_ = kContrast / sum;
+    lipschitz_ = norm_ * slope * scale_;
+  }
+
+  void eval_grid(std::uint32_t channel, std::span<const double> xs, std::span<const double> ys,
+                 std::span<const double> zs, std::span<double> out) const override {
+    std::size_t i = 0;
+    for (double z : zs)
+      for (double y : ys)
+        for (double x : xs) out[i++] = value(channel, glm::dvec3(x, y, z));
+  }
+
+  Interval bound(std::uint32_t channel, const glm::dvec3& lo, const glm::dvec3& hi) const override {
+    const double v = value(channel, 0.5 * (lo + hi));
+    const double r = lipschitz_ * 0.5 * glm::length(hi - lo);
+    return {std::max(0.0, v - r), std::min(1.0, v + r)};
+  }
+
+  double lipschitz(std::uint32_t) const override { return lipschitz_; }
+
+ private:
+  double value(std::uint32_t channel, const glm::dvec3& x) const noexcept {
+    const glm::dvec3 q = x * scale_;
+    double amp = 1.0, freq = kBaseFreq, fbm = 0.0;
+    for (int o = 0; o < kOctaves; ++o) {
+      // Per-octave offsets keep lattice points of different octaves from coinciding.
+      const glm::dvec3 off(17.31 * o, 5.77 * o, 11.13 * o);
+      fbm += amp * (2.0 * value_noise(q * freq + off, 0x7a5bull + 131ull * channel) - 1.0);
+      amp *= 0.5;
+      freq *= 2.0;
+    }
+    return std::clamp(0.5 + norm_ * fbm, 0.0, 1.0);
+  }
+
+  double scale_;
+  double norm_ = 0.0;
+  double lipschitz_ = 0.0;
+};
+
+// The bulb is centred in the volume and scaled so that normalized distance 0.5 is kSpan / 2.
+// v = smoothstep(1 - DE / kShell) inside radius kCutoff and exactly 0 outside, so region bounds
+// can prove emptiness away from the bulb.
+class MandelbulbField final : public Field {
+ public:
+  static constexpr double kSpan = 2.6;
+  static constexpr double kShell = 0.02;
+  static constexpr double kCutoff = 1.25;
+  static constexpr int kIterations = 10;
+
+  explicit MandelbulbField(const glm::u64vec3& extent)
+      : centre_(glm::dvec3(extent) * 0.5),
+        scale_(kSpan / double(std::max({extent.x, extent.y, extent.z}))) {}
+
+  void eval_grid(std::uint32_t channel, std::span<const double> xs, std::span<const double> ys,
+                 std::span<const double> zs, std::span<double> out) const override {
+    std::size_t i = 0;
+    for (double z : zs)
+      for (double y : ys)
+        for (double x : xs) out[i++] = value(channel, glm::dvec3(x, y, z));
+  }
+
+  Interval bound(std::uint32_t, const glm::dvec3& lo, const glm::dvec3& hi) const override {
+    if (box_min_distance(centre_, lo, hi) * scale_ > kCutoff) return {0.0, 0.0};
+    return {0.0, 1.0};
+  }
+
+  double lipschitz(std::uint32_t) const override { return std::numeric_limits<double>::infinity(); }
+
+ private:
+  double value(std::uint32_t channel, const glm::dvec3& x) const noexcept {
+    const glm::dvec3 c = (x - centre_) * scale_;
+    if (glm::length(c) > kCutoff) return 0.0;
+    // Channels beyond the first see a slightly different power, i.e. a different bulb.
+    const double power = 8.0 + 0.5 * double(channel);
+    glm::dvec3 z = c;
+    double dr = 1.0, r = 0.0;
+    bool escaped = false;
+    for (int i = 0; i < kIterations; ++i) {
+      r = glm::length(z);
+      if (r > 2.0) {
+        escaped = true;
+        break;
+      }
+      if (r < 1e-12) {
+        z = c;
+        continue;
+      }
+      const double theta = std::acos(std::clamp(z.z / r, -1.0, 1.0)) * power;
+      const double phi = std::atan2(z.y, z.x) * power;
+      const double rp = std::pow(r, power - 1.0);
+      dr = rp * power * dr + 1.0;
+      const double zr = rp * r;
+      z = zr * glm::dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                          std::cos(theta)) +
+          c;
+    }
+    if (!escaped) return 1.0;
+    const double de = 0.5 * std::log(r) * r / dr;
+    return smoothstep01(1.0 - de / kShell);
+  }
+
+  glm::dvec3 centre_;
+  double scale_;
+};
+
+}  // namespace
+
+std::unique_ptr<Field> make_turbulence_field(const glm::u64vec3& extent, std::uint32_t) {
+  return std::make_unique<TurbulenceField>(extent);
+}
+std::unique_ptr<Field> make_mandelbulb_field(const glm::u64vec3& extent, std::uint32_t) {
+  return std::make_unique<MandelbulbField>(extent);
+}
+
+}  // namespace resoct::procedural
