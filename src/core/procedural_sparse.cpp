@@ -73,31 +73,39 @@ class TubesField final : public Field {
 
   void eval_grid(std::uint32_t channel, std::span<const double> xs, std::span<const double> ys,
                  std::span<const double> zs, std::span<double> out) const override {
-    glm::dvec3 lo, hi;
-    grid_bounds(xs, ys, zs, lo, hi);
-    // Only segments that can reach the grid's box matter; most boxes have none.
+    // Tiles of kTile x kTile points per z: culling per tile keeps the candidate list short even
+    // when the whole grid spans many tubes.
+    constexpr std::size_t kTile = 8;
+    const std::size_t nx = xs.size(), ny = ys.size();
     std::vector<const Segment*> near;
-    const glm::dvec3 c = 0.5 * (lo + hi);
-    const double hd = 0.5 * glm::length(hi - lo);
-    for (const Segment& s : segments_[channel]) {
-      if (segment_distance(c, s.a, s.b) - hd < s.reach()) near.push_back(&s);
-    }
-    if (near.empty()) {
-      std::fill(out.begin(), out.end(), 0.0);
-      return;
-    }
-    std::size_t i = 0;
-    for (double z : zs)
-      for (double y : ys)
-        for (double x : xs) {
-          const glm::dvec3 p(x, y, z);
-          double v = 0.0;
-          for (const Segment* s : near) {
-            const double d = segment_distance(p, s->a, s->b);
-            if (d < s->reach()) v = std::max(v, s->profile(d));
+    for (std::size_t z = 0; z < zs.size(); ++z) {
+      for (std::size_t y0 = 0; y0 < ny; y0 += kTile) {
+        const std::size_t y1 = std::min(ny, y0 + kTile);
+        for (std::size_t x0 = 0; x0 < nx; x0 += kTile) {
+          const std::size_t x1 = std::min(nx, x0 + kTile);
+          glm::dvec3 lo, hi;
+          grid_bounds(xs.subspan(x0, x1 - x0), ys.subspan(y0, y1 - y0), zs.subspan(z, 1), lo, hi);
+          const glm::dvec3 c = 0.5 * (lo + hi);
+          const double hd = 0.5 * glm::length(hi - lo);
+          near.clear();
+          for (const Segment& s : segments_[channel]) {
+            if (segment_distance(c, s.a, s.b) - hd < s.reach()) near.push_back(&s);
           }
-          out[i++] = v;
+          for (std::size_t y = y0; y < y1; ++y) {
+            double* row = out.data() + (z * ny + y) * nx;
+            for (std::size_t x = x0; x < x1; ++x) {
+              const glm::dvec3 p(xs[x], ys[y], zs[z]);
+              double v = 0.0;
+              for (const Segment* s : near) {
+                const double d = segment_distance(p, s->a, s->b);
+                if (d < s->reach()) v = std::max(v, s->profile(d));
+              }
+              row[x] = v;
+            }
+          }
         }
+      }
+    }
   }
 
   Interval bound(std::uint32_t channel, const glm::dvec3& lo, const glm::dvec3& hi) const override {
