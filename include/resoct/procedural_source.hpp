@@ -21,21 +21,32 @@
 /// Values use the type's default range (u8 0..255, u16 0..65535, f32 0..1). Integer datasets
 /// store round(v * max) of a field v in [0, 1].
 ///
-/// Coarser levels. Level l voxels follow the box filter of downsample.hpp:
-/// - when every axis has factor_log2 <= 2 (footprint <= 4 voxels per axis) they are computed
+/// Coarser levels. Level l voxels follow the box filter of downsample.hpp. With s =
+/// samples_log2 (default 2):
+/// - when every axis has factor_log2 <= s (footprint <= 2^s voxels per axis) they are computed
 ///   exactly: level-0 voxels of the footprint, downsampled level by level as the hierarchy does;
-/// - otherwise each footprint axis is cut into 2^min(f, 2) sub-intervals (the recursive children
-///   at factor g = f - min(f, 2), clamped to the volume, with the recursive filter's weights) and
+/// - otherwise each footprint axis is cut into 2^min(f, s) sub-intervals (the recursive children
+///   at factor g = f - min(f, s), clamped to the volume, with the recursive filter's weights) and
 ///   the field is sampled once at each sub-interval's centre (the mean of its voxel centres); the
-///   weighted mean is rounded once.
+///   weighted mean is rounded once. So every brick of every level costs at most 8^s field
+///   evaluations per voxel, at any volume size.
 /// Error bound (coarse_error_bound): against exact recursive downsampling of the stored level 0,
-///   |error| <= L * D + Q, with L the field's Lipschitz constant (value units per level-0
-///   voxel), D = sqrt(sum_a ((2^g_a - 1) / 2)^2) the farthest a voxel centre lies from the sample
-///   standing for it, and Q = 0.5 * (l + 2) for integer types (level-0 rounding, l rounding
-///   steps of the reference, the final rounding) or 1e-6 * (l + 2) for f32. Exact levels have
-///   bound 0. ramp and constant are linear, so their samples are exact and the bound reduces to
-///   Q-size float rounding; mandelbulb has no known Lipschitz constant (bound = +infinity), its
-///   observed error is reported by the tests.
+///   |error| <= L * D + Q, with L the field's Lipschitz constant (Field::lipschitz times the
+///   type's maximum: value units per level-0 voxel), D = sqrt(sum_a ((2^g_a - 1) / 2)^2) the
+///   farthest a voxel centre lies from the sample standing for it, and Q = 0.5 * (l + 2) for
+///   integer types (level-0 rounding, l rounding steps of the reference, the final rounding) or
+///   1e-6 * (l + 2) for f32. Exact levels have bound 0. The bound is proven but only tight for
+///   smooth fields (sphere: 0.036 at factor 8 on 48³); for sharp features it is far above what
+///   happens. Observed maxima on the test volumes (48³ and 64×64×16, brick 4, all levels), for
+///   s = 2 / s = 1, asserted as regression limits (in parentheses) but not proven:
+///   | tubes      | 6 / 49 of 255        (24 / 80)       |
+///   | mandelbulb | 10 / 38 of 255       (24 / 64)       | no Lipschitz constant: bound +inf
+///   | noisefloor | 2 / 12 of 255        (6 / 24)        |
+///   | turbulence | 1 / 8 of 255         (6 / 16)        |
+///   | cells      | 1375 / 8497 of 65535 (3000 / 12000)  |
+///   | sphere     | 0.008 / 0.031        (0.02 / 0.05)   |
+///   | ramp, constant | float rounding   (1e-6)          |
+///   Cost: a level-l brick takes up to 8^s times the field evaluations of a level-0 brick.
 ///
 /// region_meta is conservative for level-0 voxels: each dataset bounds its field over a box
 /// analytically (distance to tube segments, blobs and cells; Lipschitz bounds for turbulence; the
@@ -69,8 +80,15 @@ ProceduralSpec parse_procedural_spec(std::string_view spec);
 /// A BrickSource over one procedural field. Immutable; all members are thread-safe.
 class ProceduralSource : public BrickSource {
  public:
-  /// Throws Error as parse_procedural_spec, or when the layout or hierarchy is invalid.
-  explicit ProceduralSource(std::string_view spec, BrickLayout layout = {});
+  /// `samples_log2` (0..3, named s in the file comment) trades coarse-level cost for accuracy:
+  /// a level-l brick costs about 8^s times a level-0 brick. Throws Error as
+  /// parse_procedural_spec, or naming "samples_log2", or when the layout or hierarchy is invalid.
+  explicit ProceduralSource(std::string_view spec, BrickLayout layout = {},
+                            std::uint32_t samples_log2 = kDefaultSamplesLog2);
+
+  /// Default s = 2: exact up to footprints of 4 per axis, 64 samples per coarse voxel. s = 1 is
+  /// 8x cheaper per coarse brick but about 4x less accurate (see the table above).
+  static constexpr std::uint32_t kDefaultSamplesLog2 = 2;
 
   const BrickHierarchy& hierarchy() const override { return hierarchy_; }
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
@@ -79,7 +97,7 @@ class ProceduralSource : public BrickSource {
 
   const ProceduralSpec& spec() const noexcept { return spec_; }
   const procedural::Field& field() const noexcept { return *field_; }
-  /// True when level l is computed exactly from level-0 voxels (every factor_log2 <= 2).
+  /// True when level l is computed exactly from level-0 voxels (every factor_log2 <= s).
   bool exact_level(std::uint32_t level) const;
   /// The documented bound (see file comment) on |level-l voxel - exact recursive downsampling of
   /// level 0|, in stored value units. 0 for exact levels.
@@ -94,6 +112,7 @@ class ProceduralSource : public BrickSource {
   void read_approximate(std::uint32_t level, std::uint32_t channel, const Box3& box,
                         std::span<std::byte> out) const;
 
+  std::uint32_t samples_log2_;
   ProceduralSpec spec_;
   std::string name_;
   std::unique_ptr<procedural::Field> field_;

@@ -217,15 +217,20 @@ ProceduralSpec parse_procedural_spec(std::string_view spec) {
   return out;
 }
 
-ProceduralSource::ProceduralSource(std::string_view spec, BrickLayout layout)
-    : spec_(parse_procedural_spec(spec)),
+ProceduralSource::ProceduralSource(std::string_view spec, BrickLayout layout,
+                                   std::uint32_t samples_log2)
+    : samples_log2_(samples_log2 <= 3
+                        ? samples_log2
+                        : throw invalid_parameter(
+                              "samples_log2", "must be 0..3, got " + std::to_string(samples_log2))),
+      spec_(parse_procedural_spec(spec)),
       name_(canonical_name(spec_)),
       field_(procedural::make_field(spec_.name, spec_.extent, spec_.channels)),
       hierarchy_(desc_of(spec_), layout) {}
 
 bool ProceduralSource::exact_level(std::uint32_t level) const {
   const glm::uvec3 f = hierarchy_.level(level).factor_log2;
-  return f.x <= 2 && f.y <= 2 && f.z <= 2;
+  return f.x <= samples_log2_ && f.y <= samples_log2_ && f.z <= samples_log2_;
 }
 
 double ProceduralSource::coarse_error_bound(std::uint32_t level, std::uint32_t channel) const {
@@ -233,7 +238,7 @@ double ProceduralSource::coarse_error_bound(std::uint32_t level, std::uint32_t c
   const glm::uvec3 f = hierarchy_.level(level).factor_log2;
   double d2 = 0.0;
   for (int a = 0; a < 3; ++a) {
-    const std::uint32_t g = f[a] - std::min(f[a], 2u);
+    const std::uint32_t g = f[a] - std::min(f[a], samples_log2_);
     const double half = 0.5 * (std::ldexp(1.0, int(g)) - 1.0);
     d2 += half * half;
   }
@@ -265,7 +270,7 @@ void ProceduralSource::read_approximate(std::uint32_t level, std::uint32_t chann
   std::array<std::vector<double>, 3> pos, wt;
   std::array<std::vector<std::size_t>, 3> first;
   for (int a = 0; a < 3; ++a) {
-    const std::uint32_t g = f[a] - std::min(f[a], 2u);
+    const std::uint32_t g = f[a] - std::min(f[a], samples_log2_);
     for (std::int64_t i = box.lo[a]; i < box.hi[a]; ++i) {
       first[a].push_back(pos[a].size());
       axis_samples(std::uint64_t(i), f[a], g, e0[a], 1.0, pos[a], wt[a]);

@@ -97,6 +97,6 @@ inline double bump(double d, double r) noexcept {
   const double s = 1.0 - u * u;
   return s * s;
 }
-inline constexpr double kBumpSlope = 1.5396;  // 8 / (3 sqrt 3), rounded up
+inline constexpr double kBumpSlope = 1.5397;  // 8 / (3 sqrt 3) = 1.53960..., rounded up
 
 }  // namespace resoct::procedural
