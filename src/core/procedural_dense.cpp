@@ -68,6 +68,31 @@ class TurbulenceField final : public Field {
   double lipschitz_ = 0.0;
 };
 
+struct Complex {
+  double re, im;
+};
+
+// u^n by squaring: cos(n a) + i sin(n a) for u = cos a + i sin a.
+Complex cpow(Complex u, int n) noexcept {
+  Complex r{1.0, 0.0};
+  while (n > 0) {
+    if (n & 1) r = {r.re * u.re - r.im * u.im, r.re * u.im + r.im * u.re};
+    u = {u.re * u.re - u.im * u.im, 2.0 * u.re * u.im};
+    n >>= 1;
+  }
+  return r;
+}
+
+double ipow(double x, int n) noexcept {
+  double r = 1.0;
+  while (n > 0) {
+    if (n & 1) r *= x;
+    x *= x;
+    n >>= 1;
+  }
+  return r;
+}
+
 // The bulb is centred in the volume and scaled so that normalized distance 0.5 is kSpan / 2.
 // v = smoothstep(1 - DE / kShell) inside radius kCutoff and exactly 0 outside, so region bounds
 // can prove emptiness away from the bulb.
@@ -101,8 +126,9 @@ class MandelbulbField final : public Field {
   double value(std::uint32_t channel, const glm::dvec3& x) const noexcept {
     const glm::dvec3 c = (x - centre_) * scale_;
     if (glm::length(c) > kCutoff) return 0.0;
-    // Channels beyond the first see a slightly different power, i.e. a different bulb.
-    const double power = 8.0 + 0.5 * double(channel);
+    // Channel c is the power-(8 + c) bulb. Integer powers allow the angle multiplication to be
+    // done as complex powers of (cos, sin), without trigonometric calls.
+    const int power = 8 + int(channel);
     glm::dvec3 z = c;
     double dr = 1.0, r = 0.0;
     bool escaped = false;
@@ -116,14 +142,14 @@ class MandelbulbField final : public Field {
         z = c;
         continue;
       }
-      const double theta = std::acos(std::clamp(z.z / r, -1.0, 1.0)) * power;
-      const double phi = std::atan2(z.y, z.x) * power;
-      const double rp = std::pow(r, power - 1.0);
-      dr = rp * power * dr + 1.0;
+      const double rho = std::sqrt(z.x * z.x + z.y * z.y);
+      const Complex theta = cpow({z.z / r, rho / r}, power);
+      const Complex phi =
+          cpow(rho > 0.0 ? Complex{z.x / rho, z.y / rho} : Complex{1.0, 0.0}, power);
+      const double rp = ipow(r, power - 1);
+      dr = rp * double(power) * dr + 1.0;
       const double zr = rp * r;
-      z = zr * glm::dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                          std::cos(theta)) +
-          c;
+      z = zr * glm::dvec3(theta.im * phi.re, theta.im * phi.im, theta.re) + c;
     }
     if (!escaped) return 1.0;
     const double de = 0.5 * std::log(r) * r / dr;

@@ -127,12 +127,19 @@ class TubesField final : public Field {
   // Grows one branch in normalized coordinates and recurses into 2 or 3 thinner children.
   static void grow(Rng& rng, const glm::dvec3& qext, const glm::dvec3& p, const glm::dvec3& dir,
                    double len, double radius, int depth, std::vector<Segment>& out) {
-    const glm::dvec3 b = glm::clamp(p + dir * len, 0.03 * qext, 0.97 * qext);
+    // A branch about to leave the volume turns back instead of running along the border.
+    glm::dvec3 d = dir;
+    const glm::dvec3 lo = 0.03 * qext, hi = 0.97 * qext;
+    for (int a = 0; a < 3; ++a) {
+      const double e = p[a] + d[a] * len;
+      if (e < lo[a] || e > hi[a]) d[a] = -d[a];
+    }
+    const glm::dvec3 b = glm::clamp(p + d * len, lo, hi);
     out.push_back(Segment{p, b, radius, 0.6 * radius, rng.uniform(0.55, 1.0)});
     if (depth == 0) return;
     const int children = rng.uniform() < 0.3 ? 3 : 2;
     for (int k = 0; k < children; ++k) {
-      const glm::dvec3 nd = glm::normalize(dir + 0.9 * random_unit(rng));
+      const glm::dvec3 nd = glm::normalize(d + 0.9 * random_unit(rng));
       grow(rng, qext, b, nd, len * 0.75, radius * 0.72, depth - 1, out);
     }
   }
