@@ -36,8 +36,11 @@ constexpr std::array<DatasetInfo, 8> kDatasets{{
     {"ramp", VoxelType::f32, {64, 64, 64}, 1, 16, 1, make_ramp_field},
     {"sphere", VoxelType::f32, {64, 64, 64}, 1, 16, 1, make_sphere_field},
 }};
-constexpr std::array<std::string_view, 8> kNames{"tubes", "noisefloor", "turbulence", "mandelbulb",
-                                                 "cells", "constant",   "ramp",       "sphere"};
+constexpr std::array<std::string_view, kDatasets.size()> kNames = [] {
+  std::array<std::string_view, kDatasets.size()> n{};
+  for (std::size_t i = 0; i < kDatasets.size(); ++i) n[i] = kDatasets[i].name;
+  return n;
+}();
 
 const DatasetInfo* find_dataset(std::string_view name) {
   for (const DatasetInfo& d : kDatasets) {
