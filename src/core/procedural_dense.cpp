@@ -1,6 +1,7 @@
 // Dense procedural fields: "turbulence" (fractal value-noise fBm) and "mandelbulb" (a shell
 // around the power-8 Mandelbulb from its distance estimate).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -35,14 +36,16 @@ class TurbulenceField final : public Field {
 
   void eval_grid(std::uint32_t channel, std::span<const double> xs, std::span<const double> ys,
                  std::span<const double> zs, std::span<double> out) const override {
+    Octaves noise = octaves(channel);
     std::size_t i = 0;
     for (double z : zs)
       for (double y : ys)
-        for (double x : xs) out[i++] = value(channel, glm::dvec3(x, y, z));
+        for (double x : xs) out[i++] = value(noise, glm::dvec3(x, y, z));
   }
 
   Interval bound(std::uint32_t channel, const glm::dvec3& lo, const glm::dvec3& hi) const override {
-    const double v = value(channel, 0.5 * (lo + hi));
+    Octaves noise = octaves(channel);
+    const double v = value(noise, 0.5 * (lo + hi));
     const double r = lipschitz_ * 0.5 * glm::length(hi - lo);
     return {std::max(0.0, v - r), std::min(1.0, v + r)};
   }
@@ -50,13 +53,19 @@ class TurbulenceField final : public Field {
   double lipschitz(std::uint32_t) const override { return lipschitz_; }
 
  private:
-  double value(std::uint32_t channel, const glm::dvec3& x) const noexcept {
+  using Octaves = std::array<ValueNoise, kOctaves>;
+  static Octaves octaves(std::uint32_t channel) noexcept {
+    const std::uint64_t seed = 0x7a5bull + 131ull * channel;
+    return {ValueNoise(seed), ValueNoise(seed), ValueNoise(seed), ValueNoise(seed)};
+  }
+
+  double value(Octaves& noise, const glm::dvec3& x) const noexcept {
     const glm::dvec3 q = x * scale_;
     double amp = 1.0, freq = kBaseFreq, fbm = 0.0;
     for (int o = 0; o < kOctaves; ++o) {
       // Per-octave offsets keep lattice points of different octaves from coinciding.
       const glm::dvec3 off(17.31 * o, 5.77 * o, 11.13 * o);
-      fbm += amp * (2.0 * value_noise(q * freq + off, 0x7a5bull + 131ull * channel) - 1.0);
+      fbm += amp * (2.0 * noise[std::size_t(o)](q * freq + off) - 1.0);
       amp *= 0.5;
       freq *= 2.0;
     }

@@ -193,13 +193,13 @@ class NoiseFloorField final : public Field {
     for (const Blob& b : blobs_[channel]) {
       if (box_min_distance(b.centre, lo, hi) < b.radius) near.push_back(&b);
     }
-    const std::uint64_t seed = 0x5eedull + channel;
+    ValueNoise noise(0x5eedull + channel);
     std::size_t i = 0;
     for (double z : zs)
       for (double y : ys)
         for (double x : xs) {
           const glm::dvec3 p(x, y, z);
-          double v = kFloorLo + kFloorAmp * value_noise(p * scale_, seed);
+          double v = kFloorLo + kFloorAmp * noise(p * scale_);
           for (const Blob* b : near) v = std::max(v, b->value(glm::length(p - b->centre)));
           out[i++] = v;
         }

@@ -46,21 +46,41 @@ inline double fade(double t) noexcept {
 
 /// Value noise in [0, 1] with lattice spacing 1. Each partial derivative is at most
 /// 15/8 (fade slope times the largest lattice difference 1), so the gradient norm is at most
-/// kValueNoiseLipschitz.
-inline double value_noise(const glm::dvec3& p, std::uint64_t seed) noexcept {
-  const glm::dvec3 f = glm::floor(p);
-  const glm::dvec3 t = p - f;
-  const std::int64_t x = std::int64_t(f.x), y = std::int64_t(f.y), z = std::int64_t(f.z);
-  const double u = fade(t.x), v = fade(t.y), w = fade(t.z);
-  auto h = [&](int dx, int dy, int dz) { return lattice_hash(x + dx, y + dy, z + dz, seed); };
-  const double x00 = h(0, 0, 0) + u * (h(1, 0, 0) - h(0, 0, 0));
-  const double x10 = h(0, 1, 0) + u * (h(1, 1, 0) - h(0, 1, 0));
-  const double x01 = h(0, 0, 1) + u * (h(1, 0, 1) - h(0, 0, 1));
-  const double x11 = h(0, 1, 1) + u * (h(1, 1, 1) - h(0, 1, 1));
-  const double y0 = x00 + v * (x10 - x00);
-  const double y1 = x01 + v * (x11 - x01);
-  return y0 + w * (y1 - y0);
-}
+/// kValueNoiseLipschitz. Remembers the corner values of the last lattice cell, because
+/// neighbouring samples mostly share it; one instance per thread and seed.
+class ValueNoise {
+ public:
+  explicit ValueNoise(std::uint64_t seed) noexcept : seed_(seed) {}
+  double operator()(const glm::dvec3& p) noexcept {
+    const glm::dvec3 f = glm::floor(p);
+    const std::int64_t x = std::int64_t(f.x), y = std::int64_t(f.y), z = std::int64_t(f.z);
+    if (!valid_ || x != cx_ || y != cy_ || z != cz_) {
+      for (int k = 0; k < 8; ++k) {
+        corner_[k] = lattice_hash(x + (k & 1), y + ((k >> 1) & 1), z + (k >> 2), seed_);
+      }
+      cx_ = x;
+      cy_ = y;
+      cz_ = z;
+      valid_ = true;
+    }
+    const glm::dvec3 t = p - f;
+    const double u = fade(t.x), v = fade(t.y), w = fade(t.z);
+    const double* h = corner_;
+    const double x00 = h[0] + u * (h[1] - h[0]);
+    const double x10 = h[2] + u * (h[3] - h[2]);
+    const double x01 = h[4] + u * (h[5] - h[4]);
+    const double x11 = h[6] + u * (h[7] - h[6]);
+    const double y0 = x00 + v * (x10 - x00);
+    const double y1 = x01 + v * (x11 - x01);
+    return y0 + w * (y1 - y0);
+  }
+
+ private:
+  std::uint64_t seed_;
+  bool valid_ = false;
+  std::int64_t cx_ = 0, cy_ = 0, cz_ = 0;
+  double corner_[8] = {};
+};
 inline constexpr double kValueNoiseLipschitz = 1.875 * 1.7320508075688772;
 
 /// Smoothstep 3t^2 - 2t^3 of t clamped to [0, 1]; slope at most 3/2.
