@@ -55,6 +55,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -91,7 +92,11 @@ class ProceduralSource : public BrickSource {
   static constexpr std::uint32_t kDefaultSamplesLog2 = 2;
 
   const BrickHierarchy& hierarchy() const override { return hierarchy_; }
+  /// Bricks whose level-0 footprint the field provably holds constant (empty space) are filled
+  /// without evaluating the field.
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
+  /// Answered from field bounds for provably constant bricks, else by scanning the brick.
+  BrickMeta brick_meta(BrickKey key) const override;
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
   std::string name() const override { return name_; }
 
@@ -108,6 +113,9 @@ class ProceduralSource : public BrickSource {
                    std::span<std::byte> out) const;
 
  private:
+  Box3 brick_region(BrickKey key) const;
+  std::optional<double> constant_value(std::uint32_t level, std::uint32_t channel,
+                                       const Box3& region) const;
   void read_level0(std::uint32_t channel, const Box3& box, std::span<std::byte> out) const;
   void read_approximate(std::uint32_t level, std::uint32_t channel, const Box3& box,
                         std::span<std::byte> out) const;

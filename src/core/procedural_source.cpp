@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,10 @@ std::unique_ptr<Field> make_field(std::string_view name, const glm::u64vec3& ext
 namespace {
 
 constexpr std::string_view kPrefix = "procedural:";
+
+// Field bounds are widened by this before quantizing, so that evaluation and bounding
+// arithmetic cannot disagree in the last bit.
+constexpr double kBoundSlack = 1e-9;
 
 std::vector<std::string_view> split(std::string_view s, char sep) {
   std::vector<std::string_view> out;
@@ -331,15 +336,54 @@ void ProceduralSource::read_region(std::uint32_t level, std::uint32_t channel, c
       [&](const Box3& b0, std::span<std::byte> o) { read_level0(channel, b0, o); }, out);
 }
 
+Box3 ProceduralSource::brick_region(BrickKey key) const {
+  const std::uint32_t l = key.level();
+  return intersect(hierarchy_.padded_box(l, key.brick()),
+                   Box3{glm::i64vec3(0), glm::i64vec3(hierarchy_.level(l).extent)});
+}
+
+std::optional<double> ProceduralSource::constant_value(std::uint32_t level, std::uint32_t channel,
+                                                       const Box3& region) const {
+  // Every level-l voxel of the region, exact or approximated, is a weighted mean of field values
+  // inside the region's level-0 footprint. When the field's bound over the footprint quantizes
+  // to one value, every such mean (and every rounding of it) is that value.
+  const glm::uvec3 f = hierarchy_.level(level).factor_log2;
+  glm::dvec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = double(region.lo[a] << f[a]) + 0.5;
+    hi[a] = double(std::min(region.hi[a] << f[a], std::int64_t(spec_.extent[a]))) - 0.5;
+  }
+  const procedural::Interval iv = field_->bound(channel, lo, hi);
+  const double a = quantized(iv.lo - kBoundSlack, spec_.type);
+  const double b = quantized(iv.hi + kBoundSlack, spec_.type);
+  if (a != b) return std::nullopt;
+  return a;
+}
+
 void ProceduralSource::read_brick(BrickKey key, std::span<std::byte> out) const {
   check_brick_request(key, out);
-  const std::uint32_t l = key.level();
-  const Box3 padded = hierarchy_.padded_box(l, key.brick());
-  const Box3 region =
-      intersect(padded, Box3{glm::i64vec3(0), glm::i64vec3(hierarchy_.level(l).extent)});
-  std::vector<std::byte> buf(std::size_t(region.volume()) * voxel_size(spec_.type));
-  read_region(l, key.channel(), region, buf);
-  copy_box_clamped(buf, region, out, padded, voxel_size(spec_.type));
+  const Box3 region = brick_region(key);
+  const std::size_t vs = voxel_size(spec_.type);
+  if (const std::optional<double> v = constant_value(key.level(), key.channel(), region)) {
+    // Empty space (and any provably constant brick) costs no field evaluations.
+    std::byte one[4];
+    quantize(std::span<const double>(&*v, 1), spec_.type, one);
+    for (std::size_t i = 0; i < out.size(); i += vs) std::memcpy(out.data() + i, one, vs);
+    return;
+  }
+  std::vector<std::byte> buf(std::size_t(region.volume()) * vs);
+  read_region(key.level(), key.channel(), region, buf);
+  copy_box_clamped(buf, region, out, hierarchy_.padded_box(key.level(), key.brick()), vs);
+}
+
+BrickMeta ProceduralSource::brick_meta(BrickKey key) const {
+  if (hierarchy_.contains(key)) {
+    if (const std::optional<double> v =
+            constant_value(key.level(), key.channel(), brick_region(key))) {
+      return BrickMeta{*v, *v, true};
+    }
+  }
+  return BrickSource::brick_meta(key);
 }
 
 RegionMeta ProceduralSource::region_meta(std::uint32_t channel, const Box3& level0_region) const {
@@ -355,16 +399,15 @@ RegionMeta ProceduralSource::region_meta(std::uint32_t channel, const Box3& leve
   // Depth-limited bisection (at most 64 leaves): tight where the field bound decides quickly,
   // bounded cost everywhere.
   auto visit = [&](auto&& self, const Box3& b, int depth) -> void {
-    // Bounds over the voxel centres the box holds, widened by a hair so that evaluation and
-    // bounding arithmetic cannot disagree in the last bit.
+    // Bounds over the voxel centres the box holds.
     const procedural::Interval iv =
         field_->bound(channel, glm::dvec3(b.lo) + 0.5, glm::dvec3(b.hi) - 0.5);
     const glm::i64vec3 s = b.size();
     const int axis = s.x >= s.y && s.x >= s.z ? 0 : s.y >= s.z ? 1 : 2;
     if (depth == 0 || iv.lo == iv.hi || s[axis] < 2) {
       RegionMeta m;
-      m.min = quantized(iv.lo - 1e-9, spec_.type);
-      m.max = quantized(iv.hi + 1e-9, spec_.type);
+      m.min = quantized(iv.lo - kBoundSlack, spec_.type);
+      m.max = quantized(iv.hi + kBoundSlack, spec_.type);
       m.occupancy = occupancy_span(m.min, m.max, range);
       out.merge(m);
       return;

@@ -390,3 +390,50 @@ TEST(Procedural, SameSpecGivesSameBytesAndChannelsDiffer) {
     for (std::uint32_t d = c + 1; d < 16; ++d) EXPECT_NE(ch[c], ch[d]) << c << " vs " << d;
   }
 }
+
+TEST(Procedural, ShortcutsForConstantBricksAgreeWithFullEvaluation) {
+  // read_brick and brick_meta skip evaluation where the field is provably constant; compare both
+  // with bricks assembled from read_region, which always evaluates.
+  for (const char* name : {"tubes", "mandelbulb", "constant", "cells", "noisefloor"}) {
+    const std::string spec =
+        small_spec(name, std::string(name) == "cells" ? "64x64x12" : "64x64x64");
+    const ProceduralSource src(spec, BrickLayout{glm::uvec3(8), 1});
+    const BrickHierarchy& h = src.hierarchy();
+    const VoxelType t = src.volume().type;
+    const std::uint32_t c = src.volume().channels - 1;
+    std::uint64_t zero_bricks = 0;
+    for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+      const LevelInfo& li = h.level(l);
+      const std::vector<double> lv = read_level(src, l, c);
+      for (std::uint64_t i = 0; i < li.brick_count; ++i) {
+        const BrickKey k = h.key_from_linear(c, li.first_brick + i);
+        const std::vector<std::byte> buf = brick(src, k);
+        const Box3 p = h.padded_box(l, k.brick());
+        BrickMeta want;
+        std::size_t j = 0;
+        for (std::int64_t z = p.lo.z; z < p.hi.z; ++z)
+          for (std::int64_t y = p.lo.y; y < p.hi.y; ++y)
+            for (std::int64_t x = p.lo.x; x < p.hi.x; ++x, ++j) {
+              const double v =
+                  lv[std::size_t((test::clamp_index(z, li.extent.z) * std::int64_t(li.extent.y) +
+                                  test::clamp_index(y, li.extent.y)) *
+                                     std::int64_t(li.extent.x) +
+                                 test::clamp_index(x, li.extent.x))];
+              ASSERT_EQ(test::voxel_as_double(buf.data(), j, t), v) << name << " brick " << i;
+              if (j > 0 && v != want.min) want.constant = false;
+              want.min = std::min(want.min, v);
+              want.max = std::max(want.max, v);
+            }
+        const BrickMeta got = src.brick_meta(k);
+        EXPECT_EQ(got, want) << name << " level " << l << " brick " << i;
+        zero_bricks += got.all_zero();
+      }
+    }
+    if (std::string(name) == "tubes") {
+      EXPECT_GT(zero_bricks * 2, h.bricks_per_channel());
+    }
+    if (std::string(name) == "constant") {
+      EXPECT_EQ(zero_bricks, 0u);
+    }
+  }
+}
