@@ -10,14 +10,16 @@
 /// | tubes      | u8   | 256³               | 1..16    | sparse branching tube network, ~all 0    |
 /// | noisefloor | u8   | 256³               | 1..16    | blobs on a floor of 8..13 (never 0)      |
 /// | turbulence | u8   | 256³               | 1..16    | dense fractal value-noise turbulence     |
-/// | mandelbulb | u8   | 256³               | 1..16    | shell around the power-8 Mandelbulb      |
-/// | cells      | u16  | 1024×1024×40       | 16..32   | slab of cells, one marker per channel    |
+/// | mandelbulb | u8   | 256³               | 1..16    | shell around the power-(8 + c) Mandelbulb
+/// | | cells      | u16  | 1024×1024×40       | 16..32   | slab of cells, one marker per channel |
 /// | constant   | f32  | 64³                | 1..16    | 0.5 everywhere                           |
 /// | ramp       | f32  | 64³                | 1..16    | voxel x holds (x + 0.5) / W (channel c:  |
 /// |            |      |                    |          | axis c % 3 instead of x)                 |
 /// | sphere     | f32  | 64³                | 1..16    | max(0, 1 - r / R), r = distance of the   |
 /// |            |      |                    |          | voxel centre from the volume centre, R = |
 /// |            |      |                    |          | half the smallest extent                 |
+/// tubes, noisefloor and turbulence draw channel c from its own seed; cells channel 0 stains all
+/// nuclei and channel c >= 1 a marker-positive subset as cytoplasm, membrane or nucleus (c % 3).
 /// Values use the type's default range (u8 0..255, u16 0..65535, f32 0..1). Integer datasets
 /// store round(v * max) of a field v in [0, 1].
 ///
@@ -108,7 +110,9 @@ class ProceduralSource : public BrickSource {
   /// level 0|, in stored value units. 0 for exact levels.
   double coarse_error_bound(std::uint32_t level, std::uint32_t channel) const;
 
-  /// Voxels of `box` (inside level `level`) of one channel, dense, x fastest.
+  /// Voxels of `box` (inside level `level`) of one channel, dense, x fastest, always evaluated
+  /// (no constant-brick shortcut). Throws Error(out_of_range) for a bad channel and
+  /// Error(invalid_argument) for a box outside the level or a wrongly sized `out`.
   void read_region(std::uint32_t level, std::uint32_t channel, const Box3& box,
                    std::span<std::byte> out) const;
 
