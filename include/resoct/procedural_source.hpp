@@ -105,6 +105,7 @@ class ProceduralSource : public BrickSource {
   const ProceduralSpec& spec() const noexcept { return spec_; }
   const procedural::Field& field() const noexcept { return *field_; }
   /// True when level l is computed exactly from level-0 voxels (every factor_log2 <= s).
+  /// Throws Error(out_of_range) for a missing level (as do the members below).
   bool exact_level(std::uint32_t level) const;
   /// The documented bound (see file comment) on |level-l voxel - exact recursive downsampling of
   /// level 0|, in stored value units. 0 for exact levels.
@@ -117,6 +118,7 @@ class ProceduralSource : public BrickSource {
                    std::span<std::byte> out) const;
 
  private:
+  void check_level(std::uint32_t level) const;
   Box3 brick_region(BrickKey key) const;
   std::optional<double> constant_value(std::uint32_t level, std::uint32_t channel,
                                        const Box3& region) const;

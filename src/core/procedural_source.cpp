@@ -236,12 +236,25 @@ ProceduralSource::ProceduralSource(std::string_view spec, BrickLayout layout,
       field_(procedural::make_field(spec_.name, spec_.extent, spec_.channels)),
       hierarchy_(desc_of(spec_), layout) {}
 
+void ProceduralSource::check_level(std::uint32_t level) const {
+  if (level >= hierarchy_.level_count()) {
+    throw Error(ErrorCode::out_of_range, name_ + ": parameter 'level': " + std::to_string(level) +
+                                             " of " + std::to_string(hierarchy_.level_count()));
+  }
+}
+
 bool ProceduralSource::exact_level(std::uint32_t level) const {
+  check_level(level);
   const glm::uvec3 f = hierarchy_.level(level).factor_log2;
   return f.x <= samples_log2_ && f.y <= samples_log2_ && f.z <= samples_log2_;
 }
 
 double ProceduralSource::coarse_error_bound(std::uint32_t level, std::uint32_t channel) const {
+  if (channel >= spec_.channels) {
+    throw Error(ErrorCode::out_of_range, name_ +
+                                             ": parameter 'channel': " + std::to_string(channel) +
+                                             " of " + std::to_string(spec_.channels));
+  }
   if (exact_level(level)) return 0.0;
   const glm::uvec3 f = hierarchy_.level(level).factor_log2;
   double d2 = 0.0;

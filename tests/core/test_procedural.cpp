@@ -122,6 +122,12 @@ TEST(ProceduralSpec, RejectsMalformedSpecsNamingTheParameter) {
                       "channel 1");
   EXPECT_RESOCT_ERROR(src.region_meta(3, Box3{{0, 0, 0}, {1, 1, 1}}), ErrorCode::out_of_range,
                       "channel");
+  std::vector<std::byte> one(1);
+  EXPECT_RESOCT_ERROR(src.read_region(9, 0, Box3{{0, 0, 0}, {1, 1, 1}}, one),
+                      ErrorCode::out_of_range, "level");
+  EXPECT_RESOCT_ERROR(src.read_region(0, 0, Box3{{0, 0, 0}, {17, 1, 1}}, one), bad, "box");
+  EXPECT_RESOCT_ERROR(src.read_region(0, 0, Box3{{0, 0, 0}, {2, 1, 1}}, one), bad, "out");
+  EXPECT_RESOCT_ERROR(src.coarse_error_bound(0, 1), ErrorCode::out_of_range, "channel");
 }
 
 TEST(Procedural, AnalyticDatasetsHoldTheirDocumentedValues) {
