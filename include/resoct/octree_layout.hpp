@@ -100,6 +100,13 @@ class OctreeLayout {
   /// Leaves overlapping a level-0 box.
   NodeCoordRange leaf_range(const Box3& level0) const { return node_range(leaf_depth(), level0); }
 
+  /// The nodes at depth d - 1 containing the nodes of range r at depth d (their parents). Since
+  /// boxes nest exactly, parent_range(d, node_range(d, box)) == node_range(d - 1, box).
+  NodeCoordRange parent_range(std::uint32_t d, const NodeCoordRange& r) const noexcept {
+    const glm::uvec3 split = depths_[d].split;
+    return NodeCoordRange{r.lo >> split, ((r.hi - 1u) >> split) + 1u};
+  }
+
   /// The bits coordinate c of `axis` contributes to a local (within-depth) node index at depth d;
   /// the local index is the OR over the three axes.
   std::uint64_t local_bits(std::uint32_t d, int axis, std::uint32_t c) const noexcept {
@@ -112,13 +119,20 @@ class OctreeLayout {
   /// Calls fn(flat_index, coord) for every node of a coordinate range at depth d, x fastest.
   template <class Fn>
   void for_each_node(std::uint32_t d, const NodeCoordRange& r, Fn&& fn) const {
+    if (r.empty()) return;
     const std::uint64_t first = depths_[d].first_node;
-    for (std::uint32_t z = r.lo.z; z < r.hi.z; ++z) {
-      const std::uint64_t zb = local_bits(d, 2, z);
-      for (std::uint32_t y = r.lo.y; y < r.hi.y; ++y) {
-        const std::uint64_t yzb = zb | local_bits(d, 1, y);
-        for (std::uint32_t x = r.lo.x; x < r.hi.x; ++x) {
-          fn(first + (yzb | local_bits(d, 0, x)), glm::uvec3(x, y, z));
+    const std::array<std::uint64_t, 3>& m = axis_mask_[d];
+    // Stepping a coordinate by one inside its interleaved bits: fill the other axes' bits with
+    // ones so that the carry skips them (the usual Morton-order increment).
+    auto step = [](std::uint64_t bits, std::uint64_t mask) { return ((bits | ~mask) + 1u) & mask; };
+    const std::uint64_t x0 = local_bits(d, 0, r.lo.x);
+    std::uint64_t zb = local_bits(d, 2, r.lo.z);
+    for (std::uint32_t z = r.lo.z; z < r.hi.z; ++z, zb = step(zb, m[2])) {
+      std::uint64_t yb = local_bits(d, 1, r.lo.y);
+      for (std::uint32_t y = r.lo.y; y < r.hi.y; ++y, yb = step(yb, m[1])) {
+        std::uint64_t xb = x0;
+        for (std::uint32_t x = r.lo.x; x < r.hi.x; ++x, xb = step(xb, m[0])) {
+          fn(first + (zb | yb | xb), glm::uvec3(x, y, z));
         }
       }
     }
@@ -130,6 +144,8 @@ class OctreeLayout {
   std::vector<OctreeDepth> depths_;
   // bit_pos_[d][axis][k]: position in the local index at depth d of coordinate bit k.
   std::vector<std::array<std::array<std::uint8_t, 32>, 3>> bit_pos_;
+  // axis_mask_[d][axis]: all local-index bits that belong to that axis at depth d.
+  std::vector<std::array<std::uint64_t, 3>> axis_mask_;
   std::uint64_t node_count_ = 0;
 };
 

@@ -36,7 +36,8 @@ struct OctreeWordDelta {
 
 /// The changes since the last take_deltas(). When `full` is set so many words changed (e.g. after
 /// remap_slot()) that the backend should re-upload all of words(); `words` is then empty.
-/// Otherwise `words` lists each changed word once, sorted by index.
+/// Otherwise `words` lists each changed word once, in the order of its first change (sorting
+/// would cost more than the updates themselves; device scatters do not need it).
 struct OctreeDeltas {
   bool full = false;
   std::vector<OctreeWordDelta> words;

@@ -98,6 +98,12 @@ OctreeLayout::OctreeLayout(glm::u64vec3 extent0, glm::uvec3 leaf_size)
       below += depths_[j].child_shift;
     }
   }
+  axis_mask_.resize(depths_.size());
+  for (std::uint32_t dd = 0; dd < depth_count(); ++dd) {
+    for (int i = 0; i < 3; ++i) {
+      axis_mask_[dd][std::size_t(i)] = local_bits(dd, i, depths_[dd].count[i] - 1u);
+    }
+  }
 }
 
 std::uint32_t OctreeLayout::depth_of(std::uint64_t node) const {
@@ -175,9 +181,15 @@ NodeCoordRange OctreeLayout::node_range(std::uint32_t d, const Box3& level0) con
     const std::int64_t lo = std::clamp<std::int64_t>(level0.lo[i], 0, e);
     const std::int64_t hi = std::clamp<std::int64_t>(level0.hi[i], 0, e);
     if (hi <= lo) return NodeCoordRange{};
-    const std::int64_t n = std::int64_t(dep.node_extent[i]);
-    r.lo[i] = std::uint32_t(lo / n);
-    r.hi[i] = std::uint32_t((hi + n - 1) / n);
+    const std::uint64_t n = dep.node_extent[i];
+    if (std::has_single_bit(n)) {  // the common power-of-two leaf: no 64-bit division
+      const int s = std::countr_zero(n);
+      r.lo[i] = std::uint32_t(std::uint64_t(lo) >> s);
+      r.hi[i] = std::uint32_t((std::uint64_t(hi) + n - 1) >> s);
+    } else {
+      r.lo[i] = std::uint32_t(std::uint64_t(lo) / n);
+      r.hi[i] = std::uint32_t((std::uint64_t(hi) + n - 1) / n);
+    }
   }
   return r;
 }

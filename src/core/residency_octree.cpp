@@ -99,7 +99,6 @@ OctreeDeltas ResidencyOctree::take_deltas() {
     out.full = true;
     std::fill(dirty_bits_.begin(), dirty_bits_.end(), 0u);
   } else {
-    std::sort(dirty_list_.begin(), dirty_list_.end());
     out.words.reserve(dirty_list_.size());
     for (std::uint32_t i : dirty_list_) {
       out.words.push_back({i, words_[i]});
@@ -164,9 +163,11 @@ void ResidencyOctree::brick_added(std::uint32_t slot, std::uint32_t level, glm::
   // Depth by depth from the leaves: the nodes overlapping the brick at depth d are exactly the
   // parents of those at d + 1, and once a whole depth is unchanged every ancestor already has
   // the bit (parent = OR of children).
-  for (std::uint32_t d = layout_.leaf_depth() + 1; d-- > 0;) {
+  NodeCoordRange range = layout_.leaf_range(box);
+  if (range.empty()) return;
+  for (std::uint32_t d = layout_.leaf_depth();; --d) {
     bool changed = false;
-    layout_.for_each_node(d, layout_.node_range(d, box), [&](std::uint64_t node, glm::uvec3) {
+    layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3) {
       ++stats_.nodes_visited;
       const std::size_t i = base(node, slot);
       if ((words_[i] & bit) == 0) {
@@ -174,7 +175,8 @@ void ResidencyOctree::brick_added(std::uint32_t slot, std::uint32_t level, glm::
         changed = true;
       }
     });
-    if (!changed) break;
+    if (!changed || d == 0) break;
+    range = layout_.parent_range(d, range);
   }
 }
 
@@ -204,8 +206,9 @@ void ResidencyOctree::brick_evicted(std::uint32_t slot, std::uint32_t level, glm
   const Box3 box = hierarchy_.level0_box(level, brick);
   const std::uint32_t bit = 1u << level;
   const std::uint32_t leaf = layout_.leaf_depth();
+  NodeCoordRange range = layout_.leaf_range(box);
   bool changed = false;
-  layout_.for_each_node(leaf, layout_.node_range(leaf, box), [&](std::uint64_t node, glm::uvec3 c) {
+  layout_.for_each_node(leaf, range, [&](std::uint64_t node, glm::uvec3 c) {
     ++stats_.nodes_visited;
     const std::size_t i = base(node, slot);
     if ((words_[i] & bit) == 0) return;
@@ -218,9 +221,10 @@ void ResidencyOctree::brick_evicted(std::uint32_t slot, std::uint32_t level, glm
   });
   for (std::uint32_t d = leaf; d-- > 0 && changed;) {
     changed = false;
+    range = layout_.parent_range(d + 1, range);
     const OctreeDepth& here = layout_.depth(d);
     const OctreeDepth& next = layout_.depth(d + 1);
-    layout_.for_each_node(d, layout_.node_range(d, box), [&](std::uint64_t node, glm::uvec3) {
+    layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3) {
       ++stats_.nodes_visited;
       const std::size_t i = base(node, slot);
       if ((words_[i] & bit) == 0) return;

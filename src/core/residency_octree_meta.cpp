@@ -97,9 +97,7 @@ void ResidencyOctree::propagate_metadata(std::uint32_t slot, std::uint32_t d,
       changed = true;
     });
     if (!changed || d == 0) return;
-    const glm::uvec3 split = layout_.depth(d).split;
-    range.lo = range.lo >> split;
-    range.hi = ((range.hi - 1u) >> split) + 1u;
+    range = layout_.parent_range(d, range);
     --d;
   }
 }

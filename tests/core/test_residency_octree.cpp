@@ -1,5 +1,6 @@
 // Residency octree: randomized add/evict/remap/metadata sequences checked against brute force,
 // word deltas, early stop of the upward propagation, and hand-computed cases.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -148,9 +149,10 @@ void run_random_case(const RandomCase& rc, std::uint32_t seed) {
       if (deltas.full) {
         mirror.assign(tree.words().begin(), tree.words().end());
       } else {
-        for (std::size_t i = 1; i < deltas.words.size(); ++i) {
-          ASSERT_LT(deltas.words[i - 1].index, deltas.words[i].index);  // sorted, deduplicated
-        }
+        std::vector<std::uint32_t> idx;
+        for (const OctreeWordDelta& d : deltas.words) idx.push_back(d.index);
+        std::sort(idx.begin(), idx.end());
+        ASSERT_TRUE(std::adjacent_find(idx.begin(), idx.end()) == idx.end()) << "duplicates";
         for (const OctreeWordDelta& d : deltas.words) mirror[d.index] = d.value;
         delta_batches += deltas.words.empty() ? 0 : 1;
       }
