@@ -185,10 +185,15 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
   layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
     const Box3 nb = layout_.node_box(d, c);
     if (nb.empty() || intersect(nb, box0) != nb) return;  // only nodes the brick fully covers
-    OwnMeta& o = own(node, slot);
-    if (level > 0 && (o.has_direct || o.has_exact || (o.has_approx && o.approx_level < level))) {
-      return;  // an estimate never replaces conservative data or a finer estimate
+    if (level > 0) {
+      const auto it = own_.find(node * slots_ + slot);
+      const OwnMeta* had = it == own_.end() ? nullptr : &it->second;
+      if (had != nullptr &&
+          (had->has_direct || had->has_exact || (had->has_approx && had->approx_level < level))) {
+        return;  // an estimate never replaces conservative data or a finer estimate
+      }
     }
+    OwnMeta& o = own(node, slot);
     const Box3 lv = intersect(hierarchy_.level_box_from_level0(level, nb), core);
     Scan s;
     switch (type) {
