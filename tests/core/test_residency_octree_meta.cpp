@@ -2,7 +2,11 @@
 // metadata checked against the true voxels of a volume.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <limits>
 #include <random>
 #include <set>
@@ -136,6 +140,38 @@ TEST(OctreeNodeWords, ResolutionSubstitutionLookups) {
   EXPECT_EQ(k::resoct_node_state(f), k::RESOCT_NODE_APPROX);
   EXPECT_EQ(k::resoct_node_approx_level(f), 17u);
   EXPECT_FALSE(k::resoct_node_has_metadata(0u));
+}
+
+// The record header must stay valid GLSL: compile a shader that uses every helper.
+TEST(OctreeNodeWords, HeaderCompilesAsGlsl) {
+  if (std::system("glslangValidator --version > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "glslangValidator not installed";
+  }
+  const std::string dir = std::string(RESOCT_BINARY_DIR) + "/octree_node_glsl";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir + "/node.comp");
+    f << "#version 450\n#extension GL_GOOGLE_include_directive : require\n"
+         "#include \"resoct/kernel/octree_node.glsl.h\"\n"
+         "layout(local_size_x = 1) in;\n"
+         "layout(std430, binding = 0) buffer B { uint w[]; };\n"
+         "void main() {\n"
+         "  uint b = resoct_node_base(3u, 1u, 4u);\n"
+         "  uint mm = resoct_node_merge_minmax(w[b + RESOCT_NODE_MINMAX],\n"
+         "                                     resoct_node_pack_minmax(3u, 9u));\n"
+         "  w[0] = mm + uint(resoct_node_next_coarser(w[b], 2u))\n"
+         "       + uint(resoct_node_next_finer(w[b], 2u)) + resoct_node_min16(mm)\n"
+         "       + resoct_node_max16(mm) + (resoct_node_range_empty(mm) ? 1u : 0u);\n"
+         "  w[1] = resoct_node_may_be_visible(mm, w[2], 1u, 5u, 7u) ? 1u : 0u;\n"
+         "  w[2] = resoct_node_make_flags(RESOCT_NODE_APPROX, 3u)\n"
+         "       + resoct_node_approx_level(w[3]) + (resoct_node_has_metadata(w[3]) ? 1u : 0u)\n"
+         "       + (resoct_node_partially_mapped(w[0], 1u) ? 1u : 0u)\n"
+         "       + resoct_node_state(w[3]) + RESOCT_NODE_UNKNOWN + RESOCT_NODE_VALID;\n"
+         "}\n";
+  }
+  const std::string cmd = "glslangValidator -V -I" + std::string(RESOCT_SOURCE_DIR) + "/include " +
+                          dir + "/node.comp -o " + dir + "/node.spv > " + dir + "/log.txt 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << "see " << dir << "/log.txt";
 }
 
 // A small f32 volume with blocky structure, NaN and out-of-range values, and the bricks and region
