@@ -1,0 +1,164 @@
+// resoct single-source kernel: the per-frame records every backend hands to the traversal.
+//
+// All records are structs of 4-byte scalars only, so their std430 layout equals the C++ layout
+// (no vec3 padding). The host fills them (src/core/frame_tables.cpp); the CPU backend reads them
+// directly, the Vulkan backend uploads them to storage buffers.
+//
+// Coordinate systems (see docs/rendering.md):
+//   box space      the volume's normalized physical box: min corner at the origin, the longest
+//                  physical axis spans [0, 1]. Cameras, steps, footprints and t live here.
+//   voxel space    level-0 voxel coordinates: voxel i spans [i, i + 1) per axis. Octree nodes
+//                  and bricks are integer boxes here. A box-space vector v is v * voxels_per_box.
+// Precision: a voxel-space position is kept as an exact integer cell (ivec3) plus a float
+// offset relative to it, starting from the eye (eye_cell + eye_frac), so that a 2^20-voxel axis
+// samples correctly near the camera. Nothing global is stored as a normalized float.
+#ifndef RESOCT_KERNEL_FRAME_GLSL_H
+#define RESOCT_KERNEL_FRAME_GLSL_H
+
+#include "resoct/kernel/common.glsl.h"
+
+RESOCT_KERNEL_BEGIN
+
+// RenderMode (frame.mode): the three methods of paper 000 Table 1 in one kernel.
+RESOCT_CONST(uint, RESOCT_MODE_RESIDENCY, 0u);  // residency octree (default)
+RESOCT_CONST(uint, RESOCT_MODE_PAGETABLE, 1u);  // page table only, no substitution
+RESOCT_CONST(uint, RESOCT_MODE_OCTREE, 2u);     // standard octree, one brick per node
+
+RESOCT_CONST(uint, RESOCT_PROJECTION_PERSPECTIVE, 0u);
+RESOCT_CONST(uint, RESOCT_PROJECTION_ORTHOGRAPHIC, 1u);
+
+// Most visible slots one frame may hold (bounds per-ray arrays in the kernel).
+RESOCT_CONST(uint, RESOCT_MAX_SLOTS, 32u);
+
+// Per-frame constants.
+struct ResoctFrame {
+  // Output and configuration.
+  uint width;            // pixels
+  uint height;           // pixels
+  uint mode;             // RESOCT_MODE_*
+  uint slot_count;       // entries of the slot table (visible channels, importance order)
+  uint level_count;      // brick hierarchy levels
+  uint depth_count;      // octree depths (root = 0)
+  uint start_depth;      // traversal starts here (clamped to depth_count - 1)
+  uint max_iterations;   // hard cap of march iterations per ray; hits are counted
+  uint projection;       // RESOCT_PROJECTION_*
+  uint frame_index;      // host frame counter
+  uint page_slot_count;  // slots of the page table and octree (>= the visible ones)
+  uint node_slot_count;  // slots per octree node record (== page_slot_count)
+
+  // Camera in box space: orthonormal basis, eye position.
+  float eye_x;
+  float eye_y;
+  float eye_z;
+  float forward_x;
+  float forward_y;
+  float forward_z;
+  float right_x;
+  float right_y;
+  float right_z;
+  float up_x;
+  float up_y;
+  float up_z;
+  float half_height;  // perspective: tan(fov / 2); orthographic: view height / 2 in box units
+  float aspect;       // width / height
+
+  // The eye in voxel space, split into an exact cell and a fraction in [0, 1).
+  int eye_cell_x;
+  int eye_cell_y;
+  int eye_cell_z;
+  float eye_frac_x;
+  float eye_frac_y;
+  float eye_frac_z;
+  // Level-0 voxels per box unit along each axis (1 / voxel size in box units).
+  float voxels_per_box_x;
+  float voxels_per_box_y;
+  float voxels_per_box_z;
+
+  // Volume and bricks (voxel space).
+  uint extent_x;  // level-0 voxels per axis (< 2^31)
+  uint extent_y;
+  uint extent_z;
+  uint brick_x;  // brick core size per axis
+  uint brick_y;
+  uint brick_z;
+  uint halo;      // ghost voxels per side
+  uint padded_x;  // brick + 2 halo
+  uint padded_y;
+  uint padded_z;
+
+  // Sampling (box space).
+  float finest_voxel_x;  // voxel size of the finest level any visible channel may use
+  float finest_voxel_y;
+  float finest_voxel_z;
+  float step_scale;      // scene step_scale
+  float min_step;        // floor of the step so every iteration advances
+  float ref_step;        // Δ₀: the step transfer-function alpha refers to
+  float footprint_base;  // pixel footprint at depth z: base + slope * z
+  float footprint_slope;
+  float lod_error_px;
+  float ert_opacity;
+  float background_r;  // straight alpha
+  float background_g;
+  float background_b;
+  float background_a;
+};
+
+// One visible channel, in importance order (slot table index 0 is traversed first).
+struct ResoctSlotInfo {
+  uint slot;          // page-table / octree slot this channel occupies
+  uint finest_level;  // allowed level range, clamped to the hierarchy
+  uint coarsest_level;
+  uint vis_bins;   // occupancy bins where the transfer function is visible (alpha > 0)
+  uint vis_lo16;   // visible normalized value range quantized like node min/max:
+  uint vis_hi16;   //   lo rounded down, hi rounded up; vis_lo16 > vis_hi16 = never visible
+  float range_lo;  // raw voxel value -> normalized: (raw - range_lo) * inv_range_width
+  float inv_range_width;
+};
+
+// One brick-hierarchy level.
+struct ResoctLevelInfo {
+  uint bricks_x;  // bricks per axis
+  uint bricks_y;
+  uint bricks_z;
+  uint factor_log2_x;  // level voxel = level-0 voxel >> factor_log2
+  uint factor_log2_y;
+  uint factor_log2_z;
+  uint extent_x;  // voxels per axis at this level
+  uint extent_y;
+  uint extent_z;
+  float size_log2;  // log2 of the largest voxel dimension in box units (LOD choice)
+};
+
+// One octree depth (see OctreeLayout): node (cx, cy, cz) covers voxels
+// [c * node_extent, (c + 1) * node_extent) per axis, clamped to the volume. Children of a node
+// are contiguous; local index of a child = (parent_local << child_shift) | child bits, the child
+// bits being the low coordinate bit of each split axis, z then y then x with x least significant.
+struct ResoctDepthInfo {
+  uint count_x;  // nodes per axis
+  uint count_y;
+  uint count_z;
+  uint split_x;  // 1 when this depth halves the axis relative to the previous depth
+  uint split_y;
+  uint split_z;
+  uint child_shift;    // log2 of children per parent (number of split axes)
+  uint first_node;     // flat index of the depth's first node
+  uint node_extent_x;  // voxels per node per axis (before clamping)
+  uint node_extent_y;
+  uint node_extent_z;
+};
+
+// What one ray reports besides its colour (summed per frame by the backend).
+struct ResoctRayStats {
+  uint samples;         // samples composited (any channel)
+  uint nodes;           // octree nodes (or standard-octree levels) visited
+  uint brick_accesses;  // cache-slot reads (per sample and channel)
+  uint iterations;      // march iterations
+  uint cap_hits;        // 1 when max_iterations stopped the ray
+  uint requests;        // request inserts attempted
+  float skipped;        // box-space distance skipped as empty
+  float marched;        // box-space distance marched inside the volume
+};
+
+RESOCT_KERNEL_END
+
+#endif  // RESOCT_KERNEL_FRAME_GLSL_H
