@@ -28,7 +28,7 @@ const char* procedural_spec(Kind kind) {
   switch (kind) {
     case Kind::tubes: return "procedural:tubes:256x256x256";
     case Kind::turbulence: return "procedural:turbulence:256x256x256";
-    case Kind::cells: return "procedural:cells:256x256x40:4";
+    case Kind::cells: return "procedural:cells:256x256x40:16";
     default: return nullptr;
   }
 }

@@ -7,5 +7,5 @@ bash scripts/install-deps.sh
 bash scripts/build.sh release
 mkdir -p out
 bin=build/release/examples
-"$bin/resoct-convert" procedural:cells:256x256x40:4 out/demo-cells.rbs --codec zstd
+"$bin/resoct-convert" procedural:cells:256x256x40:16 out/demo-cells.rbs --codec zstd
 "$bin/resoct-info" out/demo-cells.rbs
