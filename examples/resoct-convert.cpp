@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -73,7 +75,8 @@ BrickLayout parse_layout(const Args& a) {
   try {
     layout.validate();
   } catch (const Error& e) {
-    throw Error(e.code(), std::string("--brick/--halo: ") + e.what());
+    const bool brick = std::string_view(e.what()).find("brick_size") != std::string_view::npos;
+    throw Error(e.code(), std::string(brick ? "--brick: " : "--halo: ") + e.what());
   }
   return layout;
 }
@@ -110,6 +113,13 @@ std::vector<ValueRange> scan_f32_ranges(const DenseVolume& v) {
 
 std::unique_ptr<BrickSource> open_raw(const Args& a, const CLI::App& app,
                                       const BrickLayout& layout) {
+  // A missing file is the likelier mistake than missing raw options: say that first.
+  struct stat st {};
+  if (::stat(a.input.c_str(), &st) != 0) {
+    throw file_error(ErrorCode::io, a.input, 0,
+                     std::string("cannot open input: ") + std::strerror(errno) +
+                         " (input is procedural:NAME[:WxHxD[:CHANNELS]] or a raw file)");
+  }
   if (app.count("--dims") == 0) {
     throw invalid_parameter("--dims",
                             "required for raw input '" + a.input + "' (e.g. 256x256x128)");
