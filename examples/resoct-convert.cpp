@@ -103,7 +103,10 @@ std::vector<ValueRange> scan_f32_ranges(const DenseVolume& v) {
       lo = std::min(lo, x);
       hi = std::max(hi, x);
     }
-    if (!(lo <= hi)) lo = 0.0f, hi = 1.0f;  // no finite voxel at all
+    if (!(lo <= hi)) {  // no finite voxel at all
+      lo = 0.0f;
+      hi = 1.0f;
+    }
     ValueRange r{double(lo), double(hi)};
     if (!(r.lo < r.hi)) r.hi = r.lo + 1.0;  // constant channel
     ranges.push_back(r);
@@ -181,7 +184,8 @@ void print_summary(const Args& a, const BrickSource& src, const StoreSummary& s,
       format_bytes(t.compressed_bytes).c_str(), std::string(to_string(s.stats.codec)).c_str(),
       ratio_text, format_bytes(s.stats.file_bytes).c_str(), format_bytes(input_bytes).c_str(),
       seconds, seconds > 0.0 ? double(input_bytes) / 1e6 / seconds : 0.0,
-      a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads);
+      std::min(256u,
+               a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads));
 }
 
 int convert(const Args& a, const CLI::App& app) {
