@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -53,6 +54,10 @@ struct RawCase {
   Endian endian;
   std::uint64_t offset;
 };
+
+void PrintTo(const RawCase& c, std::ostream* os) {
+  *os << to_string(c.type) << " " << to_string(c.endian) << " offset " << c.offset;
+}
 
 std::string case_name(const ::testing::TestParamInfo<RawCase>& info) {
   return std::string(to_string(info.param.type)) + "_" + std::string(to_string(info.param.endian)) +
