@@ -111,7 +111,7 @@ TEST(CpuTraverse, RampExactAcrossBrickBorders) {
   c.projection = Projection::orthographic;
   c.eye = {0.5, 0.0625, 2.0};
   c.target = {0.5, 0.0625, 0.0};
-  c.ortho_height = 1.0 / 64.0;  // 1 row; 64 columns of 1/64 box each
+  c.ortho_height = 1.0 / 256.0;  // 256 columns across the unit-wide box
   Scene s = make_scene(1);
   s.camera = c;
   s.viewport = {256, 1};
@@ -129,8 +129,9 @@ TEST(CpuTraverse, RampExactAcrossBrickBorders) {
 Scene tubes_scene(std::uint32_t size) {
   Scene s = make_scene(size, oblique());
   s.step_scale = 0.5;
-  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.2, {1, 0.8, 0.3, 0.1}},
-                                 {1.0, {1, 0.2, 0.1, 0.6}}},
+  // A transparent plateau below 0.1: values there (the empty background) can be culled.
+  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.1, {1, 1, 1, 0}},
+                                 {0.2, {1, 0.8, 0.3, 0.1}}, {1.0, {1, 0.2, 0.1, 0.6}}},
                              0, 0)};
   return s;
 }
@@ -157,7 +158,9 @@ TEST(CpuTraverse, ModesAgreeWhenResident) {
 }
 
 TEST(CpuTraverse, ResidencySkipsEmptySpace) {
-  ProceduralSource src("procedural:tubes:64x64x64", small_bricks());
+  // 32³ bricks (the default) against 8³ octree leaves: the page table can only skip whole
+  // EMPTY bricks, the residency octree skips every empty leaf and merges empty subtrees.
+  ProceduralSource src("procedural:tubes:64x64x64", BrickLayout{});
   ResidentScene rs(src, {0});
   const Scene s = tubes_scene(48);
   FrameOptions o;
@@ -166,7 +169,7 @@ TEST(CpuTraverse, ResidencySkipsEmptySpace) {
   const Rendered pt = render_cpu(rs, s, o);
   EXPECT_LT(max_diff(res.image, pt.image), 1e-4);
   // Iterations count every position the ray stops at (sampled or skipped from).
-  EXPECT_LT(res.stats.iterations * 3, pt.stats.iterations)
+  EXPECT_LT(res.stats.iterations * 2, pt.stats.iterations)
       << res.stats.iterations << " vs " << pt.stats.iterations;
   EXPECT_GT(res.stats.distance_skipped, res.stats.distance_marched);
 }
