@@ -40,6 +40,7 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
         for (std::uint32_t y = 0; y < li.bricks.y; ++y) {
           for (std::uint32_t x = 0; x < li.bricks.x; ++x) {
             const glm::uvec3 b(x, y, z);
+            if (options.brick_resident && !options.brick_resident(l, b)) continue;
             const BrickKey key(l, c, b);
             const BrickMeta meta = source.brick_meta(key);
             const PageAddress a{s, l, b};

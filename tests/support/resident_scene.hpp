@@ -24,6 +24,8 @@ struct ResidentOptions {
   glm::uvec3 leaf_size{8};
   /// Which levels are loaded (default: all).
   std::function<bool(std::uint32_t level)> level_resident;
+  /// Which bricks of a resident level are loaded (default: all); checked before any read.
+  std::function<bool(std::uint32_t level, glm::uvec3 brick)> brick_resident;
   /// Supply region metadata for every leaf (otherwise all records stay INVALID).
   bool metadata = true;
 };
