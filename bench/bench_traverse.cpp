@@ -54,11 +54,10 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
   rig->pages = std::make_unique<PageTable>(h, n);
   for (std::uint32_t s = 0; s < n; ++s) rig->channels->assign(s, s, *rig->pages);
   PageTable* pages = rig->pages.get();
-  rig->octree = std::make_unique<ResidencyOctree>(
-      h, rig->layout, n, [pages](std::uint32_t s, std::uint32_t l, glm::uvec3 b) {
-        return kernel::resoct_page_state(pages->entry({s, l, b})) !=
-               kernel::RESOCT_PAGE_STATE_UNMAPPED;
-      });
+  rig->octree = std::make_unique<
+      ResidencyOctree>(h, rig->layout, n, [pages](std::uint32_t s, std::uint32_t l, glm::uvec3 b) {
+    return kernel::resoct_page_state(pages->entry({s, l, b})) != kernel::RESOCT_PAGE_STATE_UNMAPPED;
+  });
   const std::size_t brick_bytes = h.layout().padded_voxels() * voxel_size(vol.type);
   std::vector<std::byte> voxels;
   std::vector<std::uint32_t> slots;
@@ -79,9 +78,9 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
           } else {
             const std::uint32_t slot = std::uint32_t(slots.size());
             voxels.resize(voxels.size() + brick_bytes);
-            rig->source->read_brick(key, std::span<std::byte>(voxels.data() + std::size_t(slot) *
-                                                                                   brick_bytes,
-                                                              brick_bytes));
+            rig->source->read_brick(
+                key,
+                std::span<std::byte>(voxels.data() + std::size_t(slot) * brick_bytes, brick_bytes));
             rig->pages->set_mapped({s, 0, b}, slot);
             slots.push_back(slot);
           }

@@ -29,7 +29,7 @@ struct KernelContext {
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
   VoxelType type = VoxelType::u8;
-  int padded_x = 1, padded_y = 1, padded_z = 1;
+  glm::ivec3 padded{1};
   RequestSet* brick_requests = nullptr;
   RequestSet* node_requests = nullptr;
   std::atomic<std::uint64_t>* used = nullptr;
@@ -45,29 +45,36 @@ inline float load_voxel(const std::byte* base, std::size_t i) {
   return float(v);
 }
 
+// Clamps to [0, hi]; NaN goes to 0 so that no NaN ever becomes an index.
+inline float clamp_coord(float v, float hi) {
+  return v > 0.0f ? (v < hi ? v : hi) : 0.0f;
+}
+
 template <class T>
-inline float trilinear(const std::byte* brick, int px, int py, glm::vec3 pos) {
+inline float trilinear(const std::byte* brick, glm::ivec3 padded, glm::vec3 pos) {
   // Clamp to the outermost voxel centres (clamp-to-edge), then interpolate the 2x2x2 cell.
-  const float cx = std::clamp(pos.x - 0.5f, 0.0f, float(px - 1));
-  const float cy = std::clamp(pos.y - 0.5f, 0.0f, float(py - 1));
-  const float cz = std::clamp(g_ctx.padded_z > 0 ? pos.z - 0.5f : 0.0f, 0.0f,
-                              float(g_ctx.padded_z - 1));
-  const int x0 = std::min(int(cx), std::max(px - 2, 0));
-  const int y0 = std::min(int(cy), std::max(py - 2, 0));
-  const int z0 = std::min(int(cz), std::max(g_ctx.padded_z - 2, 0));
-  const int x1 = std::min(x0 + 1, px - 1);
-  const int y1 = std::min(y0 + 1, py - 1);
-  const int z1 = std::min(z0 + 1, g_ctx.padded_z - 1);
+  const float cx = clamp_coord(pos.x - 0.5f, float(padded.x - 1));
+  const float cy = clamp_coord(pos.y - 0.5f, float(padded.y - 1));
+  const float cz = clamp_coord(pos.z - 0.5f, float(padded.z - 1));
+  const int x0 = std::min(int(cx), std::max(padded.x - 2, 0));
+  const int y0 = std::min(int(cy), std::max(padded.y - 2, 0));
+  const int z0 = std::min(int(cz), std::max(padded.z - 2, 0));
+  const std::size_t dx = x0 + 1 < padded.x ? 1u : 0u;
+  const std::size_t dy = y0 + 1 < padded.y ? std::size_t(padded.x) : 0u;
+  const std::size_t dz = z0 + 1 < padded.z ? std::size_t(padded.x) * std::size_t(padded.y) : 0u;
   const float fx = cx - float(x0), fy = cy - float(y0), fz = cz - float(z0);
-  auto at = [&](int x, int y, int z) {
-    return load_voxel<T>(brick, (std::size_t(z) * std::size_t(py) + std::size_t(y)) *
-                                        std::size_t(px) +
-                                    std::size_t(x));
-  };
-  const float c00 = at(x0, y0, z0) + fx * (at(x1, y0, z0) - at(x0, y0, z0));
-  const float c10 = at(x0, y1, z0) + fx * (at(x1, y1, z0) - at(x0, y1, z0));
-  const float c01 = at(x0, y0, z1) + fx * (at(x1, y0, z1) - at(x0, y0, z1));
-  const float c11 = at(x0, y1, z1) + fx * (at(x1, y1, z1) - at(x0, y1, z1));
+  const std::size_t i =
+      (std::size_t(z0) * std::size_t(padded.y) + std::size_t(y0)) * std::size_t(padded.x) +
+      std::size_t(x0);
+  const float v000 = load_voxel<T>(brick, i), v100 = load_voxel<T>(brick, i + dx);
+  const float v010 = load_voxel<T>(brick, i + dy), v110 = load_voxel<T>(brick, i + dy + dx);
+  const float v001 = load_voxel<T>(brick, i + dz), v101 = load_voxel<T>(brick, i + dz + dx);
+  const float v011 = load_voxel<T>(brick, i + dz + dy);
+  const float v111 = load_voxel<T>(brick, i + dz + dy + dx);
+  const float c00 = v000 + fx * (v100 - v000);
+  const float c10 = v010 + fx * (v110 - v010);
+  const float c01 = v001 + fx * (v101 - v001);
+  const float c11 = v011 + fx * (v111 - v011);
   const float c0 = c00 + fy * (c10 - c00);
   const float c1 = c01 + fy * (c11 - c01);
   return c0 + fz * (c1 - c0);
@@ -104,13 +111,11 @@ inline float resoct_read_level_size_log2(uint level) {
 }
 inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
   const auto& c = cpu::detail::g_ctx;
-  const std::byte* brick =
-      c.cache + std::size_t(cache_slot) * c.slot_voxels * voxel_size(c.type);
+  const std::byte* brick = c.cache + std::size_t(cache_slot) * c.slot_voxels * voxel_size(c.type);
   switch (c.type) {
-    case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.padded_x, c.padded_y, pos);
-    case VoxelType::u16:
-      return cpu::detail::trilinear<std::uint16_t>(brick, c.padded_x, c.padded_y, pos);
-    case VoxelType::f32: return cpu::detail::trilinear<float>(brick, c.padded_x, c.padded_y, pos);
+    case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.padded, pos);
+    case VoxelType::u16: return cpu::detail::trilinear<std::uint16_t>(brick, c.padded, pos);
+    case VoxelType::f32: return cpu::detail::trilinear<float>(brick, c.padded, pos);
   }
   return 0.0f;
 }
@@ -142,9 +147,8 @@ void resize_zeroed(std::vector<T>& v, std::size_t n, const char* what) {
   try {
     v.assign(n, T{});
   } catch (const std::bad_alloc&) {
-    throw Error(ErrorCode::out_of_memory,
-                std::string("cpu backend: cannot allocate ") + what + " (" + std::to_string(n) +
-                    " elements)");
+    throw Error(ErrorCode::out_of_memory, std::string("cpu backend: cannot allocate ") + what +
+                                              " (" + std::to_string(n) + " elements)");
   }
 }
 
@@ -182,7 +186,8 @@ void CpuBackend::configure(const BackendConfig& config) {
   resize_zeroed(page_offsets_, std::size_t(config.page_tables) + 1u, "page table offsets");
   resize_zeroed(nodes_, std::size_t(config.node_words), "octree");
   used_words_ = (std::size_t(config.cache_slots) + 63u) / 64u;
-  used_bits_ = std::make_unique<std::atomic<std::uint64_t>[]>(std::max<std::size_t>(used_words_, 1));
+  used_bits_ =
+      std::make_unique<std::atomic<std::uint64_t>[]>(std::max<std::size_t>(used_words_, 1));
   for (std::size_t i = 0; i < used_words_; ++i) used_bits_[i].store(0);
   brick_requests_ = std::make_unique<RequestSet>(config.brick_request_capacity);
   node_requests_ = std::make_unique<RequestSet>(config.node_request_capacity);
@@ -207,8 +212,7 @@ void CpuBackend::update(const FrameUpdate& u) {
   }
   if (u.pages_full) {
     if (u.all_pages.size() != pages_.size()) {
-      throw invalid_parameter("update", "full page table of " +
-                                            std::to_string(u.all_pages.size()) +
+      throw invalid_parameter("update", "full page table of " + std::to_string(u.all_pages.size()) +
                                             " entries, expected " + std::to_string(pages_.size()));
     }
     if (u.page_table_offsets.size() != page_offsets_.size()) {
@@ -289,9 +293,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;
   c.type = config_.voxel_type;
-  c.padded_x = int(config_.padded_brick.x);
-  c.padded_y = int(config_.padded_brick.y);
-  c.padded_z = int(config_.padded_brick.z);
+  c.padded = glm::ivec3(config_.padded_brick);
   c.brick_requests = brick_requests_.get();
   c.node_requests = node_requests_.get();
   c.used = used_bits_.get();
@@ -321,8 +323,8 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
         kernel::ResoctRayStats st{};
         const glm::vec4 p = kernel::resoct_render_pixel(frame, x, y, st);
         // The image holds straight alpha (docs/rendering.md "Compositing").
-        pixels[std::size_t(y) * frame.width + x] = p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a)
-                                                              : glm::vec4(0.0f);
+        pixels[std::size_t(y) * frame.width + x] =
+            p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
         samples += st.samples;
         nodes += st.nodes;
         accesses += st.brick_accesses;

@@ -89,9 +89,9 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   }
   if (options.max_iterations == 0) throw invalid_parameter("max_iterations", "must be >= 1");
   if (scene.channels.size() > kernel::RESOCT_MAX_SLOTS) {
-    throw invalid_parameter("scene.channels", "more than " +
-                                                  std::to_string(kernel::RESOCT_MAX_SLOTS) +
-                                                  " visible channels");
+    throw invalid_parameter(
+        "scene.channels",
+        "more than " + std::to_string(kernel::RESOCT_MAX_SLOTS) + " visible channels");
   }
   const std::uint32_t level_count = hierarchy.level_count();
   const BrickLayout& bl = hierarchy.layout();

@@ -16,8 +16,7 @@ bool have_glslang() {
 TEST(TraverseGlsl, KernelCompilesAsGlsl) {
   if (!have_glslang()) GTEST_SKIP() << "glslangValidator not on PATH";
   const std::string src = RESOCT_SOURCE_DIR;
-  const std::filesystem::path out =
-      std::filesystem::path(RESOCT_BINARY_DIR) / "traverse_check.spv";
+  const std::filesystem::path out = std::filesystem::path(RESOCT_BINARY_DIR) / "traverse_check.spv";
   std::filesystem::remove(out);
   const std::string cmd = "glslangValidator -V --target-env vulkan1.2 -I\"" + src +
                           "/include\" -o \"" + out.string() + "\" \"" + src +

@@ -136,8 +136,8 @@ TEST(CpuHardCases, GrazingRaysAndMisses) {
 }
 
 TEST(CpuHardCases, ThinVolumes) {
-  for (const char* spec : {"procedural:ramp:16x16x1", "procedural:ramp:40x40x1",
-                           "procedural:ramp:795x8x1"}) {
+  for (const char* spec :
+       {"procedural:ramp:16x16x1", "procedural:ramp:40x40x1", "procedural:ramp:795x8x1"}) {
     ProceduralSource src(spec, bricks8());
     Camera c;
     c.eye = {0.3, 1.2, 0.9};
@@ -270,8 +270,7 @@ TEST(CpuHardCases, TransparentAndOpaqueTransferFunctions) {
   // Opaque everywhere: every ray that enters the volume shows the TF colour.
   s.channels = {make_channel(0, {{0.0, {0.9, 0.1, 0.3, 1}}}, 0, 0)};
   const Rendered r = render_cpu(rs, s);
-  const Rendered ref{render_reference(s, src.hierarchy().volume(), level0_voxels(src)), {}, {},
-                     {}};
+  const Rendered ref{render_reference(s, src.hierarchy().volume(), level0_voxels(src)), {}, {}, {}};
   EXPECT_LT(max_diff(r.image, ref.image), 1e-5);
   EXPECT_EQ(r.image.at(12, 12), glm::vec4(0.9f, 0.1f, 0.3f, 1.0f));
 }

@@ -52,9 +52,8 @@ void expect_matches_reference(const std::string& spec, const Scene& scene,
 
 TEST(CpuTraverse, ReferenceMatchSphere) {
   Scene s = make_scene(48, oblique());
-  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.3, {1, 0.6, 0.2, 0.05}},
-                                 {1.0, {0.2, 0.4, 1.0, 0.3}}},
-                             0, 0)};
+  s.channels = {make_channel(
+      0, {{0.0, {1, 1, 1, 0}}, {0.3, {1, 0.6, 0.2, 0.05}}, {1.0, {0.2, 0.4, 1.0, 0.3}}}, 0, 0)};
   expect_matches_reference("procedural:sphere:32x32x32", s, {0});
 }
 
@@ -130,8 +129,11 @@ Scene tubes_scene(std::uint32_t size) {
   Scene s = make_scene(size, oblique());
   s.step_scale = 0.5;
   // A transparent plateau below 0.1: values there (the empty background) can be culled.
-  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.1, {1, 1, 1, 0}},
-                                 {0.2, {1, 0.8, 0.3, 0.1}}, {1.0, {1, 0.2, 0.1, 0.6}}},
+  s.channels = {make_channel(0,
+                             {{0.0, {1, 1, 1, 0}},
+                              {0.1, {1, 1, 1, 0}},
+                              {0.2, {1, 0.8, 0.3, 0.1}},
+                              {1.0, {1, 0.2, 0.1, 0.6}}},
                              0, 0)};
   return s;
 }
@@ -180,8 +182,7 @@ TEST(CpuTraverse, ImportanceOrderDoesNotChangeTheImage) {
   Scene s = make_scene(32, oblique());
   for (std::uint32_t c = 0; c < 3; ++c) {
     s.channels.push_back(make_channel(
-        c, {{0.0, {0, 0, 0, 0}}, {0.3, {c == 0 ? 1.0 : 0.2, c == 1 ? 1.0 : 0.2, 0.5, 0.2}}}, 0,
-        0));
+        c, {{0.0, {0, 0, 0, 0}}, {0.3, {c == 0 ? 1.0 : 0.2, c == 1 ? 1.0 : 0.2, 0.5, 0.2}}}, 0, 0));
   }
   const Rendered a = render_cpu(rs, s);
   s.channels[2].importance = -5;
@@ -265,10 +266,9 @@ TEST(CpuTraverse, FrameTablesSlotOrderAndVisibility) {
   ProceduralSource src("procedural:ramp:16x16x16:3", small_bricks());
   ResidentScene rs(src, {0, 1, 2});
   Scene s = make_scene(8, oblique());
-  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.5, {1, 1, 1, 0}}, {0.75, {1, 1, 1, 1}}},
-                             1, 3),
-                make_channel(1, {{0.0, {1, 1, 1, 0}}}, 0, 3),
-                make_channel(2, {{0.0, {1, 1, 1, 0.5}}}, 0, 3)};
+  s.channels = {
+      make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.5, {1, 1, 1, 0}}, {0.75, {1, 1, 1, 1}}}, 1, 3),
+      make_channel(1, {{0.0, {1, 1, 1, 0}}}, 0, 3), make_channel(2, {{0.0, {1, 1, 1, 0.5}}}, 0, 3)};
   s.channels[0].importance = 1;
   s.channels[1].importance = 1;
   s.channels[2].importance = 2;

@@ -58,21 +58,48 @@ RESOCT_FN void resoct_ray_position(ivec3 origin_cell, vec3 origin_frac, vec3 dir
   frac = origin_frac + t * dir_vox;
   resoct_split_normalize(cell, frac);
   // floor(frac) can leave frac == 1.0 after rounding of frac - floor(frac); keep it half-open.
-  if (frac.x >= 1.0f) { cell.x = cell.x + 1; frac.x = 0.0f; }
-  if (frac.y >= 1.0f) { cell.y = cell.y + 1; frac.y = 0.0f; }
-  if (frac.z >= 1.0f) { cell.z = cell.z + 1; frac.z = 0.0f; }
+  if (frac.x >= 1.0f) {
+    cell.x = cell.x + 1;
+    frac.x = 0.0f;
+  }
+  if (frac.y >= 1.0f) {
+    cell.y = cell.y + 1;
+    frac.y = 0.0f;
+  }
+  if (frac.z >= 1.0f) {
+    cell.z = cell.z + 1;
+    frac.z = 0.0f;
+  }
 }
 
 /// Clamps a position into the volume [0, extent) (drift of a sample at the border by rounding).
 RESOCT_FN void resoct_clamp_position(ResoctFrame f, RESOCT_INOUT(ivec3) cell,
                                      RESOCT_INOUT(vec3) frac) {
   ivec3 hi = ivec3(int(f.extent_x) - 1, int(f.extent_y) - 1, int(f.extent_z) - 1);
-  if (cell.x < 0) { cell.x = 0; frac.x = 0.0f; }
-  if (cell.y < 0) { cell.y = 0; frac.y = 0.0f; }
-  if (cell.z < 0) { cell.z = 0; frac.z = 0.0f; }
-  if (cell.x > hi.x) { cell.x = hi.x; frac.x = 0.99999994f; }
-  if (cell.y > hi.y) { cell.y = hi.y; frac.y = 0.99999994f; }
-  if (cell.z > hi.z) { cell.z = hi.z; frac.z = 0.99999994f; }
+  if (cell.x < 0) {
+    cell.x = 0;
+    frac.x = 0.0f;
+  }
+  if (cell.y < 0) {
+    cell.y = 0;
+    frac.y = 0.0f;
+  }
+  if (cell.z < 0) {
+    cell.z = 0;
+    frac.z = 0.0f;
+  }
+  if (cell.x > hi.x) {
+    cell.x = hi.x;
+    frac.x = 0.99999994f;
+  }
+  if (cell.y > hi.y) {
+    cell.y = hi.y;
+    frac.y = 0.99999994f;
+  }
+  if (cell.z > hi.z) {
+    cell.z = hi.z;
+    frac.z = 0.99999994f;
+  }
 }
 
 RESOCT_KERNEL_END

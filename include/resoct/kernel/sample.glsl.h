@@ -52,13 +52,13 @@ RESOCT_FN uint resoct_brick_request_key(uint slot, uint level, uint level_count,
 }
 
 /// Continuous padded-brick coordinate of a level-0 position in a brick of level L.
-RESOCT_FN vec3 resoct_padded_position(ResoctLevelInfo L, uvec3 brick_size, uint halo,
-                                      uvec3 brick, ivec3 cell, vec3 frac) {
+RESOCT_FN vec3 resoct_padded_position(ResoctLevelInfo L, uvec3 brick_size, uint halo, uvec3 brick,
+                                      ivec3 cell, vec3 frac) {
   uvec3 fl = resoct_level_factor(L);
   uvec3 c = uvec3(cell);
   uvec3 low_mask = (uvec3(1u) << fl) - uvec3(1u);
-  vec3 inv_scale = vec3(1.0f / float(1u << fl.x), 1.0f / float(1u << fl.y),
-                        1.0f / float(1u << fl.z));
+  vec3 inv_scale =
+      vec3(1.0f / float(1u << fl.x), 1.0f / float(1u << fl.y), 1.0f / float(1u << fl.z));
   ivec3 whole = ivec3(c >> fl) - ivec3(brick * brick_size);
   return vec3(whole) + (vec3(c & low_mask) + frac) * inv_scale + vec3(float(halo));
 }

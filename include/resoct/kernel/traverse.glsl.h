@@ -83,10 +83,9 @@ RESOCT_FN float resoct_box_exit(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, v
 }
 
 /// The value of a present (not UNMAPPED) page entry.
-RESOCT_FN uint resoct_entry_value(ResoctSlotInfo s, uint entry, ResoctLevelInfo L,
-                                  uvec3 brick_size, uint halo, uvec3 brick, ivec3 cell,
-                                  vec3 frac, RESOCT_OUT(float) value,
-                                  RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_entry_value(ResoctSlotInfo s, uint entry, ResoctLevelInfo L, uvec3 brick_size,
+                                  uint halo, uvec3 brick, ivec3 cell, vec3 frac,
+                                  RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
   value = 0.0f;
   uint state = resoct_page_state(entry);
   if (state == RESOCT_PAGE_STATE_EMPTY) return RESOCT_CH_EMPTY;
@@ -108,7 +107,8 @@ RESOCT_FN void resoct_request_missing(ResoctFrame f, ResoctSlotInfo s, uint leve
                                       RESOCT_INOUT(ResoctRayStats) st) {
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(level);
-  uint key = resoct_brick_request_key(s.slot, level, f.level_count, L, resoct_brick_at(L, bs, cell));
+  uint key =
+      resoct_brick_request_key(s.slot, level, f.level_count, L, resoct_brick_at(L, bs, cell));
   if (key == last_key) return;
   last_key = key;
   resoct_report_request(key);
@@ -131,8 +131,7 @@ RESOCT_FN void resoct_request_missing(ResoctFrame f, ResoctSlotInfo s, uint leve
 /// finer, checking the actual page entry at the position for each candidate.
 RESOCT_FN uint resoct_residency_channel(ResoctFrame f, ResoctSlotInfo s, uint node, uint target,
                                         ivec3 cell, vec3 frac, RESOCT_INOUT(uint) last_key,
-                                        RESOCT_OUT(float) value,
-                                        RESOCT_INOUT(ResoctRayStats) st) {
+                                        RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
   value = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(target);
@@ -142,9 +141,9 @@ RESOCT_FN uint resoct_residency_channel(ResoctFrame f, ResoctSlotInfo s, uint no
     return resoct_entry_value(s, e, L, bs, f.halo, b, cell, frac, value, st);
   }
   resoct_request_missing(f, s, target, cell, last_key, st);
-  uint r = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
-                            RESOCT_NODE_RESIDENCY) &
-           resoct_allowed_levels(s);
+  uint r =
+      resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) + RESOCT_NODE_RESIDENCY) &
+      resoct_allowed_levels(s);
   if (r == 0u) return RESOCT_CH_NONE;
   int l = resoct_node_next_coarser(r, target);
   while (l >= 0) {
@@ -189,8 +188,8 @@ RESOCT_FN uint resoct_pagetable_channel(ResoctFrame f, ResoctSlotInfo s, uint ta
   }
   uint res = resoct_entry_value(s, e, L, bs, f.halo, b, cell, frac, value, st);
   if (res == RESOCT_CH_EMPTY) {
-    skip_exit = resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b),
-                                resoct_brick_size0(L, bs));
+    skip_exit =
+        resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b), resoct_brick_size0(L, bs));
   }
   return res;
 }
@@ -268,8 +267,7 @@ RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
   if (!resoct_node_may_be_visible(minmax, occupancy, s.vis_lo16, s.vis_hi16, s.vis_bins)) {
     return RESOCT_NODE_CLASS_EMPTY;
   }
-  if (state == RESOCT_NODE_VALID &&
-      resoct_node_min16(minmax) == resoct_node_max16(minmax)) {
+  if (state == RESOCT_NODE_VALID && resoct_node_min16(minmax) == resoct_node_max16(minmax)) {
     return RESOCT_NODE_CLASS_HOMOGENEOUS;
   }
   return RESOCT_NODE_CLASS_VISIBLE;
@@ -383,8 +381,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
         for (uint d = 0u; d <= trav_depth; ++d) {
           ResoctDepthInfo D = resoct_read_depth(d);
           if (d > 0u) {
-            local = (local << D.child_shift) |
-                    resoct_node_child_bits(D, resoct_node_coord(D, cell));
+            local =
+                (local << D.child_shift) | resoct_node_child_bits(D, resoct_node_coord(D, cell));
           }
           if (d < f.start_depth) continue;
           uint nd = D.first_node + local;
@@ -444,8 +442,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
             res = RESOCT_CH_VALUE;
           } else {
             uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-            res = resoct_residency_channel(f, s, node, target, cell, frac, last_key[c], value,
-                                           stats);
+            res =
+                resoct_residency_channel(f, s, node, target, cell, frac, last_key[c], value, stats);
           }
           if (res == RESOCT_CH_VALUE) {
             vec4 rgba = resoct_tf_lookup(s.slot, value);
@@ -467,8 +465,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
         float exit_c = 0.0f;
         uint res;
         if (f.mode == RESOCT_MODE_OCTREE) {
-          res = resoct_octree_channel(f, s, target, cell, frac, dir_vox, last_key[c], value,
-                                      exit_c, stats);
+          res = resoct_octree_channel(f, s, target, cell, frac, dir_vox, last_key[c], value, exit_c,
+                                      stats);
         } else {
           res = resoct_pagetable_channel(f, s, target, cell, frac, dir_vox, last_key[c], value,
                                          exit_c, stats);
