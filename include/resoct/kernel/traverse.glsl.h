@@ -66,7 +66,31 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.marched = 0.0f;
 }
 
-RESOCT_FN uvec3 resoct_frame_brick_size(ResoctFrame f) {
+/// The few frame constants the per-channel helpers need (passing the whole ResoctFrame by value
+/// would copy ~220 bytes per call on the CPU where the compiler does not inline).
+struct ResoctSampleParams {
+  uint level_count;
+  uint node_slot_count;
+  uint halo;
+  uint request_greedy;
+  uint brick_x;
+  uint brick_y;
+  uint brick_z;
+};
+
+RESOCT_FN ResoctSampleParams resoct_sample_params(ResoctFrame f) {
+  ResoctSampleParams p;
+  p.level_count = f.level_count;
+  p.node_slot_count = f.node_slot_count;
+  p.halo = f.halo;
+  p.request_greedy = f.request_greedy;
+  p.brick_x = f.brick_x;
+  p.brick_y = f.brick_y;
+  p.brick_z = f.brick_z;
+  return p;
+}
+
+RESOCT_FN uvec3 resoct_frame_brick_size(ResoctSampleParams f) {
   return uvec3(f.brick_x, f.brick_y, f.brick_z);
 }
 
@@ -102,8 +126,8 @@ RESOCT_FN uint resoct_entry_value(ResoctSlotInfo s, uint entry, ResoctLevelInfo 
 
 /// Requests the target brick of a missing sample (once per ray and slot while the key repeats)
 /// and, greedy, every coarser level's brick at the position up to the first present one.
-RESOCT_FN void resoct_request_missing(ResoctFrame f, ResoctSlotInfo s, uint level, ivec3 cell,
-                                      RESOCT_INOUT(uint) last_key,
+RESOCT_FN void resoct_request_missing(ResoctSampleParams f, ResoctSlotInfo s, uint level,
+                                      ivec3 cell, RESOCT_INOUT(uint) last_key,
                                       RESOCT_INOUT(ResoctRayStats) st) {
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(level);
@@ -129,9 +153,10 @@ RESOCT_FN void resoct_request_missing(ResoctFrame f, ResoctSlotInfo s, uint leve
 /// Residency mode, one non-empty channel at the traversal node: the target level if present,
 /// else request it and substitute the nearest partially resident level, coarser first, then
 /// finer, checking the actual page entry at the position for each candidate.
-RESOCT_FN uint resoct_residency_channel(ResoctFrame f, ResoctSlotInfo s, uint node, uint target,
-                                        ivec3 cell, vec3 frac, RESOCT_INOUT(uint) last_key,
-                                        RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, uint node,
+                                        uint target, ivec3 cell, vec3 frac,
+                                        RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
+                                        RESOCT_INOUT(ResoctRayStats) st) {
   value = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(target);
@@ -172,9 +197,10 @@ RESOCT_FN uint resoct_residency_channel(ResoctFrame f, ResoctSlotInfo s, uint no
 
 /// Page-table mode, one channel: the target level or nothing (requested). `skip_exit` receives
 /// the exit offset of an EMPTY brick.
-RESOCT_FN uint resoct_pagetable_channel(ResoctFrame f, ResoctSlotInfo s, uint target, ivec3 cell,
-                                        vec3 frac, vec3 dir_vox, RESOCT_INOUT(uint) last_key,
-                                        RESOCT_OUT(float) value, RESOCT_OUT(float) skip_exit,
+RESOCT_FN uint resoct_pagetable_channel(ResoctSampleParams f, ResoctSlotInfo s, uint target,
+                                        ivec3 cell, vec3 frac, vec3 dir_vox,
+                                        RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
+                                        RESOCT_OUT(float) skip_exit,
                                         RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
@@ -197,10 +223,10 @@ RESOCT_FN uint resoct_pagetable_channel(ResoctFrame f, ResoctSlotInfo s, uint ta
 /// Standard-octree mode, one channel: walk the levels from the slot's coarsest to the target at
 /// the position (one node per level); the first missing level is requested and ends the walk,
 /// the finest present level above it is sampled; an EMPTY level makes the channel empty there.
-RESOCT_FN uint resoct_octree_channel(ResoctFrame f, ResoctSlotInfo s, uint target, ivec3 cell,
-                                     vec3 frac, vec3 dir_vox, RESOCT_INOUT(uint) last_key,
-                                     RESOCT_OUT(float) value, RESOCT_OUT(float) skip_exit,
-                                     RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_octree_channel(ResoctSampleParams f, ResoctSlotInfo s, uint target,
+                                     ivec3 cell, vec3 frac, vec3 dir_vox,
+                                     RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
+                                     RESOCT_OUT(float) skip_exit, RESOCT_INOUT(ResoctRayStats) st) {
   value = 0.0f;
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
@@ -288,12 +314,25 @@ RESOCT_FN uint resoct_traversal_depth(ResoctFrame f, float dt) {
   return depth;
 }
 
-/// Flat index of the node at depth `depth` containing a cell.
-RESOCT_FN uint resoct_node_at(uint depth, ivec3 cell) {
+/// log2 of the node counts per axis at depth D (counts are powers of two).
+RESOCT_FN uvec3 resoct_depth_count_log2(ResoctDepthInfo D) {
+  return uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
+}
+
+/// Coordinates at depth D of the ancestor of the node with coordinates `deep` at a deeper depth
+/// whose count_log2 is `deep_log2`: node boxes nest exactly, so this is a shift, not a division.
+RESOCT_FN uvec3 resoct_ancestor_coord(ResoctDepthInfo D, uvec3 deep, uvec3 deep_log2) {
+  return deep >> (deep_log2 - resoct_depth_count_log2(D));
+}
+
+/// Flat index of the node at depth `depth` whose coordinates are `coord` (count_log2
+/// `coord_log2`), built from the root by child bits.
+RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
   uint local = 0u;
   for (uint d = 1u; d <= depth; ++d) {
     ResoctDepthInfo D = resoct_read_depth(d);
-    local = (local << D.child_shift) | resoct_node_child_bits(D, resoct_node_coord(D, cell));
+    local = (local << D.child_shift) |
+            resoct_node_child_bits(D, resoct_ancestor_coord(D, coord, coord_log2));
   }
   return resoct_read_depth(depth).first_node + local;
 }
@@ -332,6 +371,9 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   vec3 finest = vec3(f.finest_voxel_x, f.finest_voxel_y, f.finest_voxel_z);
   float dt = resoct_step_size(dir_box, finest, f.step_scale, f.min_step);
   uint trav_depth = resoct_traversal_depth(f, dt);
+  ResoctSampleParams sp = resoct_sample_params(f);
+  ResoctDepthInfo trav_info = resoct_read_depth(trav_depth);
+  uvec3 trav_log2 = resoct_depth_count_log2(trav_info);
 
   uint last_key[RESOCT_MAX_SLOTS];
   for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) last_key[i] = RESOCT_REQUEST_KEY_NONE;
@@ -368,7 +410,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
     float skip_exit = RESOCT_RAY_T_INF;
 
     if (f.mode == RESOCT_MODE_RESIDENCY) {
-      uint node = resoct_node_at(trav_depth, cell);
+      uvec3 trav_coord = resoct_node_coord(trav_info, cell);
+      uint node = resoct_node_index(trav_depth, trav_coord, trav_log2);
       if (node != cached_node) {
         // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
         // node advances the channel index in the same node.
@@ -381,8 +424,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
         for (uint d = 0u; d <= trav_depth; ++d) {
           ResoctDepthInfo D = resoct_read_depth(d);
           if (d > 0u) {
-            local =
-                (local << D.child_shift) | resoct_node_child_bits(D, resoct_node_coord(D, cell));
+            local = (local << D.child_shift) |
+                    resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
           }
           if (d < f.start_depth) continue;
           uint nd = D.first_node + local;
@@ -442,8 +485,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
             res = RESOCT_CH_VALUE;
           } else {
             uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-            res =
-                resoct_residency_channel(f, s, node, target, cell, frac, last_key[c], value, stats);
+            res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
+                                           stats);
           }
           if (res == RESOCT_CH_VALUE) {
             vec4 rgba = resoct_tf_lookup(s.slot, value);
@@ -465,10 +508,10 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
         float exit_c = 0.0f;
         uint res;
         if (f.mode == RESOCT_MODE_OCTREE) {
-          res = resoct_octree_channel(f, s, target, cell, frac, dir_vox, last_key[c], value, exit_c,
-                                      stats);
+          res = resoct_octree_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
+                                      exit_c, stats);
         } else {
-          res = resoct_pagetable_channel(f, s, target, cell, frac, dir_vox, last_key[c], value,
+          res = resoct_pagetable_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
                                          exit_c, stats);
         }
         if (res == RESOCT_CH_EMPTY) {
