@@ -302,6 +302,56 @@ TEST(CpuTraverse, FrameTablesRejectUnmappedChannel) {
   EXPECT_RESOCT_ERROR(rs.tables(s, o), ErrorCode::invalid_argument, "max_iterations");
 }
 
+// OpenMP tiles may run in any order on any thread: the image, statistics and requests must not
+// depend on the thread count.
+TEST(CpuTraverse, ThreadCountDoesNotChangeTheResult) {
+  ProceduralSource src("procedural:sphere:32x32x32", small_bricks());
+  const std::uint32_t coarsest = src.hierarchy().level_count() - 1;
+  ResidentOptions ro;
+  ro.level_resident = [coarsest](std::uint32_t l) { return l != 0; };
+  ResidentScene rs(src, {0}, ro);
+  Scene s = make_scene(40, oblique());
+  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {1.0, {1, 0.5, 0.2, 0.3}}}, 0, coarsest)};
+  s.lod_error_px = 0.5;
+  const FrameTables t = rs.tables(s);
+  FrameResult one, four;
+  cpu::CpuBackend b1(1), b4(4);
+  rs.upload(b1);
+  rs.upload(b4);
+  b1.render(t, one);
+  b4.render(t, four);
+  b4.render(t, four);  // buffers reused across frames
+  EXPECT_EQ(one.image, four.image);
+  EXPECT_EQ(one.stats.samples, four.stats.samples);
+  EXPECT_EQ(one.stats.iterations, four.stats.iterations);
+  EXPECT_EQ(one.brick_requests, four.brick_requests);
+  EXPECT_EQ(one.used_cache_slots, four.used_cache_slots);
+  EXPECT_FALSE(one.brick_requests.empty());
+  EXPECT_FALSE(one.used_cache_slots.empty());
+}
+
+TEST(CpuTraverse, BackendRejectsBadUpdatesAndTables) {
+  ProceduralSource src("procedural:sphere:16x16x16", small_bricks());
+  ResidentScene rs(src, {0});
+  cpu::CpuBackend b(1);
+  rs.upload(b);
+  std::vector<std::byte> voxels(10);
+  BrickUpload up{0, voxels};
+  FrameUpdate u;
+  u.bricks = std::span<const BrickUpload>(&up, 1);
+  EXPECT_RESOCT_ERROR(b.update(u), ErrorCode::invalid_argument, "update");
+  PageDelta d{std::uint32_t(rs.pages().entries().size()), 0};
+  FrameUpdate u2;
+  u2.page_deltas = std::span<const PageDelta>(&d, 1);
+  EXPECT_RESOCT_ERROR(b.update(u2), ErrorCode::invalid_argument, "update");
+  Scene s = make_scene(8, oblique());
+  s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0.5}}})};
+  FrameTables t = rs.tables(s);
+  t.tf_luts.pop_back();
+  FrameResult r;
+  EXPECT_RESOCT_ERROR(b.render(t, r), ErrorCode::invalid_argument, "tables");
+}
+
 TEST(CpuTraverse, BackendRegistry) {
   cpu::register_backend();
   cpu::register_backend();
