@@ -337,6 +337,23 @@ RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
   return resoct_read_depth(depth).first_node + local;
 }
 
+/// Class of a channel at the node of depth `depth` on the path to (coord, coord_log2): its own
+/// record if it has metadata, else that of the nearest ancestor (down to `top`) that has, since a
+/// parent's record covers its children; INVALID when none has.
+RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
+                                         uvec3 coord_log2, ResoctSlotInfo s, uint node_slots) {
+  uint cls = resoct_node_class(node, s, node_slots);
+  uint d = depth;
+  while (cls == RESOCT_NODE_CLASS_INVALID && d > top) {
+    d = d - 1u;
+    ResoctDepthInfo D = resoct_read_depth(d);
+    cls = resoct_node_class(resoct_node_index(d, resoct_ancestor_coord(D, coord, coord_log2),
+                                              resoct_depth_count_log2(D)),
+                            s, node_slots);
+  }
+  return cls;
+}
+
 /// Renders one pixel: the premultiplied colour over the background. `stats` receives the ray's
 /// counters.
 RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
@@ -432,8 +449,9 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           stats.nodes = stats.nodes + 1u;
           while (ci < n) {
             bool empty = ((live >> ci) & 1u) == 0u ||
-                         resoct_node_class(nd, resoct_read_slot(ci), f.node_slot_count) ==
-                             RESOCT_NODE_CLASS_EMPTY;
+                         resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                                                   resoct_read_slot(ci),
+                                                   f.node_slot_count) == RESOCT_NODE_CLASS_EMPTY;
             if (!empty) break;
             cached_empty = cached_empty | (1u << ci);
             ci = ci + 1u;
@@ -444,18 +462,26 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           }
         }
         if (cached_skip_depth == RESOCT_NONE_U) {
-          // The remaining channels at the traversal node; INVALID metadata is requested and
-          // treated as not empty.
+          // The remaining channels at the traversal node. A node whose own record is INVALID
+          // is requested; its class is carried down from the nearest ancestor with metadata
+          // (not empty when there is none).
           bool invalid = false;
           for (uint c = ci; c < n; ++c) {
             if (((live >> c) & 1u) == 0u) {
               cached_empty = cached_empty | (1u << c);
               continue;
             }
-            uint cls = resoct_node_class(node, resoct_read_slot(c), f.node_slot_count);
+            ResoctSlotInfo sc = resoct_read_slot(c);
+            uint cls = resoct_node_class(node, sc, f.node_slot_count);
+            if (cls == RESOCT_NODE_CLASS_INVALID) {
+              invalid = true;
+              cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
+                                              trav_log2, sc, f.node_slot_count);
+              // A homogeneous ancestor's value is only known at the ancestor: read it there.
+              if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
+            }
             if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
             if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
-            if (cls == RESOCT_NODE_CLASS_INVALID) invalid = true;
           }
           if (invalid && node != last_node_request) {
             last_node_request = node;
