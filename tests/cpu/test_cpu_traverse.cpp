@@ -262,6 +262,31 @@ TEST(CpuTraverse, InvalidMetadataRequestsNodes) {
   EXPECT_LT(max_diff(no_meta.image, with_meta.image), 1e-4);
 }
 
+// Metadata only at a shallow depth: deeper nodes are INVALID (and requested), and a channel
+// first classified there takes the class of its nearest ancestor with metadata. Channel 1's
+// transfer function is visible only above 0.995, which the ramp never reaches, so with the
+// carried class it is never sampled: the same bricks are read as with channel 0 alone.
+TEST(CpuTraverse, InvalidNodesInheritTheNearestAncestorsClass) {
+  ProceduralSource src("procedural:ramp:32x32x32:2", small_bricks());
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(4);
+  ro.metadata_depth = 1;
+  ResidentScene rs(src, {0, 1}, ro);
+  ASSERT_GT(rs.layout().leaf_depth(), 1u);
+  Scene one = make_scene(24, oblique());
+  one.channels = {
+      make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.5, {1, 1, 1, 0}}, {1.0, {1, 0.4, 0.1, 0.3}}}, 0, 0)};
+  Scene two = one;
+  two.channels.push_back(
+      make_channel(1, {{0.0, {0, 0, 1, 0}}, {0.995, {0, 0, 1, 0}}, {1.0, {0, 0, 1, 1}}}, 0, 0));
+  const Rendered r1 = render_cpu(rs, one);
+  const Rendered r2 = render_cpu(rs, two);
+  EXPECT_FALSE(r2.nodes.empty());
+  EXPECT_GT(r1.stats.brick_accesses, 0u);
+  EXPECT_EQ(r2.stats.brick_accesses, r1.stats.brick_accesses);
+  EXPECT_LT(max_diff(r1.image, r2.image), 1e-6);
+}
+
 TEST(CpuTraverse, FrameTablesSlotOrderAndVisibility) {
   ProceduralSource src("procedural:ramp:16x16x16:3", small_bricks());
   ResidentScene rs(src, {0, 1, 2});

@@ -1,5 +1,6 @@
 #include "support/resident_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "resoct/error.hpp"
@@ -62,9 +63,9 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
       }
     }
     if (options.metadata) {
-      const std::uint32_t leaf = layout_.leaf_depth();
-      const OctreeDepth& d = layout_.depth(leaf);
-      layout_.for_each_node(leaf, NodeCoordRange{glm::uvec3(0), d.count},
+      const std::uint32_t depth = std::min(options.metadata_depth, layout_.leaf_depth());
+      const OctreeDepth& d = layout_.depth(depth);
+      layout_.for_each_node(depth, NodeCoordRange{glm::uvec3(0), d.count},
                             [&](std::uint64_t node, const glm::uvec3&) {
                               Box3 box = layout_.node_box(node);
                               if (box.empty()) return;

@@ -26,8 +26,11 @@ struct ResidentOptions {
   std::function<bool(std::uint32_t level)> level_resident;
   /// Which bricks of a resident level are loaded (default: all); checked before any read.
   std::function<bool(std::uint32_t level, glm::uvec3 brick)> brick_resident;
-  /// Supply region metadata for every leaf (otherwise all records stay INVALID).
+  /// Supply region metadata for every node of `metadata_depth` (otherwise all records stay
+  /// INVALID). Deeper nodes stay INVALID; shallower ones get it by propagation.
   bool metadata = true;
+  /// Depth that receives metadata; clamped to the leaf depth (the default).
+  std::uint32_t metadata_depth = ~0u;
 };
 
 class ResidentScene {
