@@ -201,6 +201,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
 
   // Residency mode: classification of the last traversal node, reused while samples stay in it.
   uint cached_node = RESOCT_NONE_U;
+  uvec3 cached_coord = uvec3(RESOCT_NONE_U);
   uint cached_empty = 0u;
   uint cached_homog = 0u;
   uint cached_skip_depth = RESOCT_NONE_U;
@@ -231,7 +232,10 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
 
     if (f.mode == RESOCT_MODE_RESIDENCY) {
       uvec3 trav_coord = resoct_node_coord(trav_info, cell);
-      uint node = resoct_node_index(trav_depth, trav_coord, trav_log2);
+      // Consecutive samples mostly stay in one node: skip the index walk then.
+      bool same_node = all(equal(trav_coord, cached_coord));
+      uint node = same_node ? cached_node : resoct_node_index(trav_depth, trav_coord, trav_log2);
+      cached_coord = trav_coord;
       if (node != cached_node) {
         // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
         // node advances the channel index in the same node.
