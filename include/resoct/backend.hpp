@@ -95,7 +95,7 @@ struct BackendStats {
 
 /// What render() returns.
 struct FrameResult {
-  Image image;                          ///< RGBA, premultiplied over the background
+  Image image;  ///< RGBA over the background, stored straight (docs/rendering.md "Compositing")
   std::vector<Request> brick_requests;  ///< device request keys (PageTable::device_key) + hits
   std::vector<Request> node_requests;   ///< octree node indices + hits
   std::vector<std::uint32_t> used_cache_slots;  ///< distinct cache slots sampled this frame

@@ -101,6 +101,11 @@ struct ResoctFrame {
   float background_g;
   float background_b;
   float background_a;
+
+  // Request strategy (paper 002 §5.3.2): 0 = global (only the target brick of a missing sample),
+  // 1 = greedy (the target and every coarser level's brick at the sample position up to the
+  // first one that is present or the channel's coarsest level). Added by the traversal kernel.
+  uint request_greedy;
 };
 
 // One visible channel, in importance order (slot table index 0 is traversed first).

@@ -1,0 +1,237 @@
+#include "resoct/frame_tables.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+#include "resoct/camera.hpp"
+#include "resoct/error.hpp"
+#include "resoct/residency_octree.hpp"
+
+namespace resoct {
+
+namespace {
+
+// Device coordinates are signed 32-bit integers (ivec3); keep a safety margin below 2^31 so that
+// cell + node extent never overflows.
+constexpr std::uint64_t kMaxDeviceExtent = std::uint64_t(1) << 30;
+// The eye may lie outside the volume, but its voxel cell must stay a small multiple of the
+// largest extent away so that integer differences fit 32 bits.
+constexpr double kMaxEyeCell = double(std::uint64_t(1) << 30);
+
+void fill_camera(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFrame& f) {
+  const CameraRays rays(scene.camera, scene.viewport);
+  const glm::dvec3 voxel = box_voxel_size(h.volume());
+  const glm::dvec3 per_box = 1.0 / voxel;
+  const glm::dvec3 eye = scene.camera.eye;
+  f.eye_x = float(eye.x);
+  f.eye_y = float(eye.y);
+  f.eye_z = float(eye.z);
+  f.forward_x = float(rays.forward().x);
+  f.forward_y = float(rays.forward().y);
+  f.forward_z = float(rays.forward().z);
+  f.right_x = float(rays.right().x);
+  f.right_y = float(rays.right().y);
+  f.right_z = float(rays.right().z);
+  f.up_x = float(rays.up().x);
+  f.up_y = float(rays.up().y);
+  f.up_z = float(rays.up().z);
+  const double rows = double(scene.viewport.height);
+  // CameraRays keeps its half height private; the footprint encodes it exactly.
+  f.half_height = scene.camera.projection == Projection::perspective
+                      ? float(rays.footprint_slope() * rows / 2.0)
+                      : float(rays.footprint_base() * rows / 2.0);
+  f.aspect = float(double(scene.viewport.width) / rows);
+  f.projection = scene.camera.projection == Projection::perspective
+                     ? kernel::RESOCT_PROJECTION_PERSPECTIVE
+                     : kernel::RESOCT_PROJECTION_ORTHOGRAPHIC;
+  f.footprint_base = float(rays.footprint_base());
+  f.footprint_slope = float(rays.footprint_slope());
+
+  // Split in double so that the cell is exact and the fraction carries the remaining bits.
+  const glm::dvec3 eye_vox = eye * per_box;
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(eye_vox[i]) < kMaxEyeCell)) {
+      throw invalid_parameter("scene.camera.eye",
+                              "is too far from the volume (more than 2^30 voxels)");
+    }
+  }
+  const glm::dvec3 cell = glm::floor(eye_vox);
+  f.eye_cell_x = int(cell.x);
+  f.eye_cell_y = int(cell.y);
+  f.eye_cell_z = int(cell.z);
+  f.eye_frac_x = std::min(float(eye_vox.x - cell.x), 0.99999994f);
+  f.eye_frac_y = std::min(float(eye_vox.y - cell.y), 0.99999994f);
+  f.eye_frac_z = std::min(float(eye_vox.z - cell.z), 0.99999994f);
+  f.voxels_per_box_x = float(per_box.x);
+  f.voxels_per_box_y = float(per_box.y);
+  f.voxels_per_box_z = float(per_box.z);
+}
+
+std::uint32_t check_extent(std::uint64_t v, const char* name) {
+  if (v == 0 || v >= kMaxDeviceExtent) {
+    throw invalid_parameter(name, "axis of " + std::to_string(v) +
+                                      " voxels does not fit the kernel's 32-bit coordinates");
+  }
+  return std::uint32_t(v);
+}
+
+}  // namespace
+
+void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
+                        const OctreeLayout& layout, const ChannelMap& channels,
+                        const FrameOptions& options, FrameTables& out) {
+  const VolumeDesc& volume = hierarchy.volume();
+  scene.validate(volume, "scene");
+  if (layout.extent0() != volume.extent) {
+    throw invalid_parameter("layout", "octree extent differs from the volume extent");
+  }
+  if (options.max_iterations == 0) throw invalid_parameter("max_iterations", "must be >= 1");
+  if (scene.channels.size() > kernel::RESOCT_MAX_SLOTS) {
+    throw invalid_parameter(
+        "scene.channels",
+        "more than " + std::to_string(kernel::RESOCT_MAX_SLOTS) + " visible channels");
+  }
+  const std::uint32_t level_count = hierarchy.level_count();
+  const BrickLayout& bl = hierarchy.layout();
+
+  kernel::ResoctFrame& f = out.frame;
+  f = kernel::ResoctFrame{};
+  f.width = scene.viewport.width;
+  f.height = scene.viewport.height;
+  f.mode = std::uint32_t(options.mode);
+  f.slot_count = std::uint32_t(scene.channels.size());
+  f.level_count = level_count;
+  f.depth_count = layout.depth_count();
+  f.start_depth = std::min(options.start_depth, layout.depth_count() - 1u);
+  f.max_iterations = options.max_iterations;
+  f.frame_index = options.frame_index;
+  f.page_slot_count = channels.slot_count();
+  f.node_slot_count = channels.slot_count();
+  f.request_greedy = options.request_strategy == RequestStrategy::greedy ? 1u : 0u;
+  fill_camera(scene, hierarchy, f);
+
+  f.extent_x = check_extent(volume.extent.x, "extent");
+  f.extent_y = check_extent(volume.extent.y, "extent");
+  f.extent_z = check_extent(volume.extent.z, "extent");
+  f.brick_x = bl.brick_size.x;
+  f.brick_y = bl.brick_size.y;
+  f.brick_z = bl.brick_size.z;
+  f.halo = bl.halo;
+  f.padded_x = bl.padded_size().x;
+  f.padded_y = bl.padded_size().y;
+  f.padded_z = bl.padded_size().z;
+
+  // Slot table in importance order. A stable sort keeps the scene order among full ties.
+  std::vector<std::uint32_t> order(scene.channels.size());
+  std::iota(order.begin(), order.end(), 0u);
+  const std::uint32_t last_level = level_count - 1u;
+  auto finest_of = [&](std::uint32_t i) {
+    return std::min(scene.channels[i].finest_level, last_level);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const auto& ca = scene.channels[a];
+    const auto& cb = scene.channels[b];
+    if (ca.importance != cb.importance) return ca.importance < cb.importance;
+    return finest_of(a) < finest_of(b);
+  });
+
+  out.slots.clear();
+  out.tf_luts.assign(std::size_t(channels.slot_count()) * kTfLutSize, glm::vec4(0.0f));
+  glm::dvec3 finest_voxel(std::numeric_limits<double>::infinity());
+  for (std::uint32_t i : order) {
+    const ChannelSettings& c = scene.channels[i];
+    const auto slot = channels.slot_of(c.channel);
+    if (!slot) {
+      throw invalid_parameter("channels", "channel " + std::to_string(c.channel) +
+                                              " of the scene is not shown in any slot");
+    }
+    kernel::ResoctSlotInfo s{};
+    s.slot = *slot;
+    s.finest_level = finest_of(i);
+    s.coarsest_level = std::max(s.finest_level, std::min(c.coarsest_level, last_level));
+    s.vis_bins = c.tf.visible_mask();
+    const ValueRange unit{0.0, 1.0};
+    if (c.tf.fully_transparent()) {
+      s.vis_lo16 = 1u;
+      s.vis_hi16 = 0u;
+    } else {
+      s.vis_lo16 = octree_quantize_min(c.tf.visible_intervals().front().x, unit);
+      s.vis_hi16 = octree_quantize_max(c.tf.visible_intervals().back().y, unit);
+    }
+    const ValueRange r = volume.range(c.channel);
+    s.range_lo = float(r.lo);
+    s.inv_range_width = float(1.0 / (r.hi - r.lo));
+    out.slots.push_back(s);
+
+    const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
+    std::copy(lut.begin(), lut.end(), out.tf_luts.begin() + std::ptrdiff_t(*slot) * kTfLutSize);
+    finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, s.finest_level));
+  }
+  if (scene.channels.empty()) finest_voxel = box_voxel_size(volume);
+
+  const double ref = reference_step_length(volume);
+  f.finest_voxel_x = float(finest_voxel.x);
+  f.finest_voxel_y = float(finest_voxel.y);
+  f.finest_voxel_z = float(finest_voxel.z);
+  f.step_scale = float(scene.step_scale);
+  // Far below any step a scene can ask for (1e-3 voxels in the tests), but positive.
+  f.min_step = float(ref * 0x1p-20);
+  f.ref_step = float(ref);
+  f.lod_error_px = float(scene.lod_error_px);
+  f.ert_opacity = float(scene.ert_opacity);
+  f.background_r = float(scene.background.r);
+  f.background_g = float(scene.background.g);
+  f.background_b = float(scene.background.b);
+  f.background_a = float(scene.background.a);
+
+  const std::vector<float> sizes = level_size_log2_table(hierarchy);
+  out.levels.clear();
+  for (std::uint32_t l = 0; l < level_count; ++l) {
+    const LevelInfo& li = hierarchy.level(l);
+    kernel::ResoctLevelInfo L{};
+    L.bricks_x = li.bricks.x;
+    L.bricks_y = li.bricks.y;
+    L.bricks_z = li.bricks.z;
+    L.factor_log2_x = li.factor_log2.x;
+    L.factor_log2_y = li.factor_log2.y;
+    L.factor_log2_z = li.factor_log2.z;
+    L.extent_x = std::uint32_t(li.extent.x);
+    L.extent_y = std::uint32_t(li.extent.y);
+    L.extent_z = std::uint32_t(li.extent.z);
+    L.size_log2 = sizes[l];
+    out.levels.push_back(L);
+  }
+
+  out.depths.clear();
+  for (std::uint32_t d = 0; d < layout.depth_count(); ++d) {
+    const OctreeDepth& od = layout.depth(d);
+    kernel::ResoctDepthInfo D{};
+    D.count_x = od.count.x;
+    D.count_y = od.count.y;
+    D.count_z = od.count.z;
+    D.split_x = od.split.x;
+    D.split_y = od.split.y;
+    D.split_z = od.split.z;
+    D.child_shift = od.child_shift;
+    if (od.first_node >= OctreeLayout::kMaxNodes) {
+      throw invalid_parameter("layout", "node index does not fit 32 bits");
+    }
+    D.first_node = std::uint32_t(od.first_node);
+    D.node_extent_x = check_extent(od.node_extent.x, "layout");
+    D.node_extent_y = check_extent(od.node_extent.y, "layout");
+    D.node_extent_z = check_extent(od.node_extent.z, "layout");
+    out.depths.push_back(D);
+  }
+}
+
+FrameTables build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
+                               const OctreeLayout& layout, const ChannelMap& channels,
+                               const FrameOptions& options) {
+  FrameTables t;
+  build_frame_tables(scene, hierarchy, layout, channels, options, t);
+  return t;
+}
+
+}  // namespace resoct

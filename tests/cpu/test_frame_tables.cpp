@@ -1,0 +1,129 @@
+// build_frame_tables against the double-precision camera (CameraRays) and hierarchy: the
+// kernel's per-pixel rays, the exact eye split and the sampling constants.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "resoct/camera.hpp"
+#include "resoct/frame_tables.hpp"
+#include "resoct/kernel/camera_ray.glsl.h"
+
+namespace resoct {
+namespace {
+
+struct Fixture {
+  BrickHierarchy hierarchy;
+  OctreeLayout layout;
+  PageTable pages;
+  ChannelMap channels;
+  explicit Fixture(VolumeDesc v)
+      : hierarchy(v, BrickLayout{}),
+        layout(v.extent, glm::uvec3(16)),
+        pages(hierarchy, 1),
+        channels(1, v.channels) {
+    channels.assign(0, 0, pages);
+  }
+};
+
+Scene scene_with(Camera c, Viewport vp) {
+  Scene s;
+  s.camera = c;
+  s.viewport = vp;
+  ChannelSettings ch;
+  ch.tf = TransferFunction({{0.0, {1, 1, 1, 0.5}}});
+  s.channels = {ch};
+  return s;
+}
+
+TEST(FrameTables, KernelRaysMatchCameraRays) {
+  VolumeDesc v;
+  v.extent = {200, 120, 64};
+  v.spacing = {1.0, 1.5, 2.0};
+  Fixture fx(v);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  for (Projection p : {Projection::perspective, Projection::orthographic}) {
+    for (int trial = 0; trial < 8; ++trial) {
+      Camera c;
+      c.projection = p;
+      c.eye = {u(rng) + 1.5, u(rng), u(rng) - 1.5};
+      c.target = {0.5, 0.3, 0.2};
+      c.fov_deg = 25.0 + 10.0 * trial;
+      c.ortho_height = 0.3 + 0.2 * trial;
+      const Viewport vp{37, 23};
+      const FrameTables t =
+          build_frame_tables(scene_with(c, vp), fx.hierarchy, fx.layout, fx.channels);
+      const CameraRays rays(c, vp);
+      EXPECT_NEAR(t.frame.footprint_base, rays.footprint_base(), 1e-7);
+      EXPECT_NEAR(t.frame.footprint_slope, rays.footprint_slope(), 1e-7);
+      const glm::dvec3 per_box = 1.0 / box_voxel_size(v);
+      for (std::uint32_t y = 0; y < vp.height; y += 5) {
+        for (std::uint32_t x = 0; x < vp.width; x += 4) {
+          glm::vec3 dir;
+          glm::ivec3 cell;
+          glm::vec3 frac;
+          kernel::resoct_camera_ray(t.frame, x, y, dir, cell, frac);
+          const Ray r = rays.pixel_ray(x, y);
+          for (int i = 0; i < 3; ++i) {
+            EXPECT_NEAR(dir[i], r.dir[i], 2e-6);
+            EXPECT_GE(frac[i], 0.0f);
+            EXPECT_LT(frac[i], 1.0f);
+            const double origin_vox = double(cell[i]) + double(frac[i]);
+            EXPECT_NEAR(origin_vox, r.origin[i] * per_box[i], 1e-4 * (1.0 + per_box[i]));
+          }
+        }
+      }
+    }
+  }
+}
+
+// The eye's cell is exact even where a float could not hold the voxel coordinate.
+TEST(FrameTables, EyeSplitIsExactOnHugeAxes) {
+  VolumeDesc v;
+  v.extent = {std::uint64_t(1) << 20, 4, 4};
+  Fixture fx(v);
+  Camera c;
+  c.eye = {0.7300001234, 0.5 / double(1 << 20), 2.0 / double(1 << 20)};
+  c.target = {0.2, 0.5 / double(1 << 20), 2.0 / double(1 << 20)};
+  const FrameTables t =
+      build_frame_tables(scene_with(c, {8, 8}), fx.hierarchy, fx.layout, fx.channels);
+  const double ex = c.eye.x * double(1 << 20);
+  EXPECT_EQ(t.frame.eye_cell_x, int(std::floor(ex)));
+  EXPECT_NEAR(t.frame.eye_frac_x, ex - std::floor(ex), 1e-6);
+  EXPECT_EQ(t.frame.eye_cell_y, 0);
+  EXPECT_NEAR(t.frame.eye_frac_y, 0.5, 1e-6);
+  EXPECT_EQ(t.frame.eye_cell_z, 2);
+}
+
+TEST(FrameTables, SamplingConstants) {
+  VolumeDesc v;
+  v.extent = {64, 64, 16};
+  v.spacing = {1.0, 1.0, 4.0};
+  Fixture fx(v);
+  Scene s = scene_with(Camera{}, {16, 16});
+  s.channels[0].finest_level = 1;
+  s.channels[0].coarsest_level = kMaxSceneLevel;
+  s.step_scale = 0.5;
+  const FrameTables t = build_frame_tables(s, fx.hierarchy, fx.layout, fx.channels);
+  const glm::dvec3 h1 = level_voxel_size(fx.hierarchy, 1);
+  EXPECT_FLOAT_EQ(t.frame.finest_voxel_x, float(h1.x));
+  EXPECT_FLOAT_EQ(t.frame.finest_voxel_z, float(h1.z));
+  EXPECT_FLOAT_EQ(t.frame.ref_step, float(reference_step_length(v)));
+  EXPECT_EQ(t.slots[0].coarsest_level, fx.hierarchy.level_count() - 1);
+  EXPECT_EQ(t.slots[0].finest_level, 1u);
+  const std::vector<float> sizes = level_size_log2_table(fx.hierarchy);
+  for (std::uint32_t l = 0; l < fx.hierarchy.level_count(); ++l) {
+    EXPECT_EQ(t.levels[l].size_log2, sizes[l]);
+    EXPECT_EQ(t.levels[l].bricks_x, fx.hierarchy.level(l).bricks.x);
+  }
+  for (std::uint32_t d = 0; d < fx.layout.depth_count(); ++d) {
+    EXPECT_EQ(t.depths[d].first_node, fx.layout.depth(d).first_node);
+    EXPECT_EQ(t.depths[d].node_extent_z, fx.layout.depth(d).node_extent.z);
+  }
+  EXPECT_GT(t.frame.min_step, 0.0f);
+  EXPECT_LT(t.frame.min_step, 1e-3f * t.frame.ref_step);
+}
+
+}  // namespace
+}  // namespace resoct
