@@ -25,12 +25,17 @@ namespace resoct {
 struct LoadRequest {
   BrickKey key;
   std::uint32_t hits = 0;
+  /// Frame in which the brick was first requested without interruption; older requests of a
+  /// level go first, so that a cache too small for the working set still serves every brick.
+  std::uint64_t since = 0;
 };
 
 /// A loaded brick and the hits of the request that asked for it.
 struct LoadedBrick {
   std::shared_ptr<const HostBrick> brick;
   std::uint32_t hits = 0;
+  std::uint64_t since = 0;
+  LoadRequest request() const { return {brick->key, hits, since}; }
 };
 
 /// A brick that could not be loaded; reported once.
@@ -47,7 +52,8 @@ struct BrickLoaderStats {
   std::uint64_t duplicates = 0;  ///< requests ignored: already queued, in flight, ready or failed
 };
 
-/// Loading order: coarser level first, then more hits, then smaller key (deterministic).
+/// Loading order: coarser level first, then older (smaller `since`), then more hits, then
+/// smaller key (deterministic).
 bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 
 /// Loads bricks in priority order. request() replaces the set of queued (not yet started)

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -138,7 +139,9 @@ class Renderer {
   bool send_full_ = true;                     // next update carries full arrays
   std::vector<LoadedBrick> staged_;           // loaded, waiting for budget or a free slot
   std::vector<std::uint32_t> pending_nodes_;  // node requests to answer next frame
-  std::vector<std::byte> scratch_;            // keeps the voxels of this frame's uploads alive
+  // Requested bricks -> frame of their first request in an unbroken run of frames (ageing).
+  std::unordered_map<BrickKey, std::uint64_t> waiting_since_;
+  std::vector<std::byte> scratch_;  // keeps the voxels of this frame's uploads alive
   std::vector<std::shared_ptr<const HostBrick>> upload_data_;
   std::vector<BrickUpload> uploads_;
   FrameResult result_;

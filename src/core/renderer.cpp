@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "resoct/error.hpp"
@@ -177,7 +178,7 @@ void Renderer::apply_loaded(FrameStats& stats) {
   }
   staged_.clear();
   std::sort(all.begin(), all.end(), [](const LoadedBrick& a, const LoadedBrick& b) {
-    return load_before({a.brick->key, a.hits}, {b.brick->key, b.hits});
+    return load_before(a.request(), b.request());
   });
 
   // Constant bricks only change a page entry, so they bypass the upload budget; the others are
@@ -270,6 +271,7 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
   std::unordered_set<BrickKey> skip;
   for (const LoadedBrick& b : staged_) skip.insert(b.brick->key);
   std::vector<LoadRequest> wanted;
+  std::unordered_map<BrickKey, std::uint64_t> still_waiting;
   bool outstanding = false;
   const auto available = [this](const PageAddress& a) { return !page_unmapped(pages_.entry(a)); };
   for (std::size_t i = 0; i < resolved.bricks.size(); ++i) {
@@ -285,10 +287,14 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
       const BrickKey k(chain[j].level, key.channel(), chain[j].brick);
       if (j > 0 && loader_->has_failed(k)) continue;
       if (!page_unmapped(pages_.entry(chain[j])) || !skip.insert(k).second) continue;
-      wanted.push_back(LoadRequest{k, resolved.hits[i]});
+      const auto w = waiting_since_.find(k);
+      const std::uint64_t since = w == waiting_since_.end() ? frame_ : w->second;
+      still_waiting.emplace(k, since);
+      wanted.push_back(LoadRequest{k, resolved.hits[i], since});
       if (j > 0) ++stats.ancestor_requests;
     }
   }
+  waiting_since_ = std::move(still_waiting);
   loader_->request(wanted);
   if (loader_->thread_count() == 0) {
     const std::uint64_t n =
