@@ -94,6 +94,9 @@ class Renderer {
   /// Renders until a frame reports converged or `max_frames` frames were rendered (>= 1).
   ConvergeReport render_until_converged(const Scene& scene, std::uint32_t max_frames);
 
+  /// Blocks until the loader has nothing queued or in flight (returns at once with 0 threads).
+  void wait_for_loads() { loader_->wait_idle(); }
+
   /// Called once per failed brick as soon as the failure is known (also listed in the report).
   void set_failure_callback(std::function<void(const LoadFailure&)> fn) {
     on_failure_ = std::move(fn);

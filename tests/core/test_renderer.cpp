@@ -1,6 +1,7 @@
 #include "test_renderer_support.hpp"
 
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/procedural_source.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::test {
@@ -160,6 +161,18 @@ TEST(Renderer, RejectsBadOptionsAndScenes) {
   EXPECT_RESOCT_ERROR(r.render_frame(test_scene(7)), ErrorCode::invalid_argument, "scene");
   EXPECT_RESOCT_ERROR(r.render_until_converged(test_scene(0), 0), ErrorCode::invalid_argument,
                       "max_frames");
+}
+
+TEST(Renderer, ExampleScenesFitTheirProceduralDatasets) {
+  const char* names[] = {"tubes", "noisefloor", "turbulence", "mandelbulb",
+                         "cells", "constant",   "ramp",       "sphere"};
+  for (const char* name : names) {
+    const std::string path = std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/" + name + ".json";
+    const Scene s = load_scene(path);
+    const auto src = make_procedural_source(std::string("procedural:") + name);
+    EXPECT_NO_THROW(s.validate(src->volume(), path)) << name;
+    EXPECT_EQ(s.channels.size(), std::string(name) == "cells" ? 4u : 1u) << name;
+  }
 }
 
 }  // namespace
