@@ -116,6 +116,7 @@ class Renderer {
   std::uint64_t frame_index() const noexcept { return frame_; }
 
  private:
+  FrameTables frame_tables(const Scene& scene) const;
   void assign_channels(const Scene& scene);
   void apply_loaded(FrameStats& stats);
   bool apply_one(const LoadedBrick& b, FrameStats& stats);

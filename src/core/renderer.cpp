@@ -317,6 +317,15 @@ void Renderer::report_failures(FrameReport& report) {
   }
 }
 
+FrameTables Renderer::frame_tables(const Scene& scene) const {
+  // The one place that builds the kernel's per-frame tables.
+  FrameTables tables =
+      build_frame_tables(scene, hierarchy_, layout_, channels_, options_.mode, frame_);
+  tables.frame.max_iterations = options_.max_iterations;
+  tables.frame.start_depth = options_.start_depth;
+  return tables;
+}
+
 FrameReport Renderer::render_frame(const Scene& scene) {
   const auto t_frame = Clock::now();
   scene.validate(hierarchy_.volume(), "scene");
@@ -343,11 +352,7 @@ FrameReport Renderer::render_frame(const Scene& scene) {
 
   t = Clock::now();
   const std::uint64_t epoch = channels_.epoch();
-  FrameTables tables =
-      build_frame_tables(scene, hierarchy_, layout_, channels_, options_.mode, frame_);
-  tables.frame.max_iterations = options_.max_iterations;
-  tables.frame.start_depth = options_.start_depth;
-  backend_->render(tables, result_);
+  backend_->render(frame_tables(scene), result_);
   stats.ms_render = ms_since(t);
   stats.backend = result_.stats;
 

@@ -101,8 +101,7 @@ TEST(Renderer, FirstUpdateIsFullLaterOnesAreDeltas) {
 
 TEST(Renderer, NodeRequestsAreAnsweredFromRegionMetadata) {
   auto src = make_test_source();
-  link_frame_tables_stub();
-  register_recording_backend();
+  register_test_backend();
   Renderer r(src, test_options(64, 16));
   RecordingBackend* b = last_recording_backend();
   const OctreeLayout& layout = r.layout();
@@ -136,7 +135,7 @@ TEST(Renderer, NodeRequestsAreAnsweredFromRegionMetadata) {
 
 TEST(Renderer, RejectsBadOptionsAndScenes) {
   auto src = make_test_source();
-  register_recording_backend();
+  register_test_backend();
   RendererOptions o = test_options(16, 4);
   o.eviction = "fifo";
   EXPECT_RESOCT_ERROR(Renderer(src, o), ErrorCode::invalid_argument, "eviction");

@@ -17,7 +17,13 @@
 
 namespace resoct::test {
 
-void link_frame_tables_stub();  // delete together with frame_tables_stub_for_renderer_tests.cpp
+void link_frame_tables_stub();  // MERGE(lead): delete with the stub file
+
+/// Registers the recording backend.
+inline void register_test_backend() {
+  link_frame_tables_stub();  // MERGE(lead): delete with the stub file
+  register_recording_backend();
+}
 
 /// 32³ u8, bricks 8³ + halo 1 (levels 4³, 2³, 1³ bricks). Level 0: x-brick 0 is all zero,
 /// x-brick 3 is constant 100 + channel, the others vary.
@@ -105,8 +111,7 @@ struct Rig {
   RecordingBackend* backend = nullptr;
   std::vector<std::vector<std::uint32_t>> used;  // per frame: cache slots reported as used
   Rig(std::shared_ptr<const BrickSource> src, RendererOptions o) {
-    link_frame_tables_stub();
-    register_recording_backend();
+    register_test_backend();
     renderer = std::make_unique<Renderer>(std::move(src), std::move(o));
     backend = last_recording_backend();
     Renderer* r = renderer.get();
