@@ -200,6 +200,17 @@ TEST(BrickLoader, ThreadsLoadEveryKeyExactlyOnce) {
   EXPECT_TRUE(loader.idle());
 }
 
+TEST(BrickLoader, OlderRequestsOfALevelGoFirst) {
+  auto src = std::make_shared<RecordingSource>();
+  BrickLoader loader(src, 0, 1 << 20);
+  const BrickKey young(0, 0, {0, 0, 0}), old(0, 0, {3, 3, 1}), coarse(1, 0, {1, 1, 0});
+  // Age beats hits and key within a level; a coarser level beats age.
+  const std::vector<LoadRequest> reqs{{young, 50, 9}, {old, 1, 2}, {coarse, 1, 9}};
+  loader.request(reqs);
+  loader.run_queued(10);
+  EXPECT_EQ(src->reads(), (std::vector<BrickKey>{coarse, old, young}));
+}
+
 TEST(BrickLoader, RejectsBadParameters) {
   EXPECT_RESOCT_ERROR(BrickLoader(nullptr, 0, 0), ErrorCode::invalid_argument, "source");
   EXPECT_RESOCT_ERROR(BrickLoader(std::make_shared<RecordingSource>(), 5000, 0),
