@@ -169,7 +169,7 @@ TEST(BrickLoader, FailuresAreReportedOnceAndNeverRetried) {
   EXPECT_EQ(std::count(reads.begin(), reads.end(), bad), 1);
 }
 
-TEST(BrickLoader, ThreadsLoadEveryKeyExactlyOnce) {
+TEST(BrickLoader, ThreadsReadEveryKeyExactlyOnce) {
   const auto h = RecordingSource().hierarchy();
   std::set<BrickKey> failing;
   for (std::uint64_t i = 0; i < h.bricks_per_channel(); i += 7) {
@@ -180,7 +180,9 @@ TEST(BrickLoader, ThreadsLoadEveryKeyExactlyOnce) {
   const auto reqs = all_requests(h, 11);
   std::map<BrickKey, int> delivered;
   std::size_t failures = 0;
-  // Re-requesting while the workers run must not duplicate keys in flight or ready.
+  // Re-requesting while the workers run must not duplicate keys in flight or ready. A key taken
+  // before a later round may be delivered again (from the host cache, never read again), so
+  // only totals are deterministic.
   for (int round = 0; round < 3; ++round) {
     loader.request(reqs);
     for (const LoadedBrick& b : loader.take_ready()) ++delivered[b.brick->key];
@@ -196,7 +198,11 @@ TEST(BrickLoader, ThreadsLoadEveryKeyExactlyOnce) {
     EXPECT_EQ(reads[r.key], 1) << "each key read once";
     EXPECT_EQ(delivered.count(r.key), failing.count(r.key) ? 0u : 1u);
   }
-  for (const auto& [k, n] : delivered) EXPECT_EQ(n, 1);
+  const BrickLoaderStats st = loader.stats();
+  EXPECT_EQ(st.loads, reqs.size() - failing.size());
+  std::uint64_t deliveries = 0;
+  for (const auto& [k, n] : delivered) deliveries += std::uint64_t(n);
+  EXPECT_EQ(deliveries, st.loads + st.host_hits);
   EXPECT_TRUE(loader.idle());
 }
 
