@@ -29,9 +29,15 @@ std::uint32_t slot_count_for(const RendererOptions& o, const BrickSource& s) {
   return std::min(s.volume().channels, kernel::RESOCT_MAX_SLOTS);
 }
 
-std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, std::uint32_t levels) {
+std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, const BrickHierarchy& h,
+                                            const glm::dvec3* camera) {
   if (name == "lru") return std::make_unique<LruPolicy>();
-  if (name == "octreemizer") return std::make_unique<OctreemizerPolicy>(levels);
+  if (name == "octreemizer") {
+    // Distances in physical units from the camera of the frame being rendered.
+    return std::make_unique<OctreemizerPolicy>(
+        h.level_count(), OctreemizerWeights{},
+        [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
+  }
   throw invalid_parameter("eviction", "'" + name + "' is not one of lru, octreemizer");
 }
 
@@ -74,7 +80,7 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
       channels_(pages_.slot_count(), hierarchy_.volume().channels) {
   cache_ = std::make_unique<BrickCache>(hierarchy_.layout(), hierarchy_.volume().type,
                                         options_.device_cache_bytes, options_.ttl,
-                                        make_policy(options_.eviction, hierarchy_.level_count()));
+                                        make_policy(options_.eviction, hierarchy_, &camera_));
   // Residency means "sampling needs no cache miss": EMPTY and HOMOGENEOUS entries qualify as
   // well as MAPPED ones, so the traversal may use such a level without touching the cache.
   octree_ = std::make_unique<ResidencyOctree>(
@@ -336,6 +342,11 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   }
   ++frame_;
   cache_->begin_frame(frame_);
+  {
+    // Box space has its longest physical axis spanning [0, 1] (docs/scene.md).
+    const glm::dvec3 phys = physical_size(hierarchy_.volume());
+    camera_ = scene.camera.eye * std::max({phys.x, phys.y, phys.z});
+  }
   FrameReport report;
   FrameStats& stats = report.stats;
   stats.frame_index = frame_;
