@@ -28,6 +28,8 @@ struct LoadRequest {
   /// Frame in which the brick was first requested without interruption; older requests of a
   /// level go first, so that a cache too small for the working set still serves every brick.
   std::uint64_t since = 0;
+  /// Channel rank (the scene's importance order): within a level, lower ranks load first.
+  std::uint32_t rank = 0;
 };
 
 /// A loaded brick and the hits of the request that asked for it.
@@ -35,7 +37,8 @@ struct LoadedBrick {
   std::shared_ptr<const HostBrick> brick;
   std::uint32_t hits = 0;
   std::uint64_t since = 0;
-  LoadRequest request() const { return {brick->key, hits, since}; }
+  std::uint32_t rank = 0;
+  LoadRequest request() const { return {brick->key, hits, since, rank}; }
 };
 
 /// A brick that could not be loaded; reported once.
@@ -52,8 +55,8 @@ struct BrickLoaderStats {
   std::uint64_t duplicates = 0;  ///< requests ignored: already queued, in flight, ready or failed
 };
 
-/// Loading order: coarser level first, then older (smaller `since`), then more hits, then
-/// smaller key (deterministic).
+/// Loading order: coarser level first, then lower channel rank, then older (smaller `since`),
+/// then more hits, then smaller key (deterministic).
 bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 
 /// Loads bricks in priority order. request() replaces the set of queued (not yet started)

@@ -139,7 +139,8 @@ class Renderer {
   BackendConfig config_;
   std::function<void(const LoadFailure&)> on_failure_;
 
-  glm::dvec3 camera_{0.0};  // eye in physical units (Octreemizer distances)
+  std::vector<std::uint32_t> channel_rank_;  // per dataset channel: load rank in this scene
+  glm::dvec3 camera_{0.0};                   // eye in physical units (Octreemizer distances)
   std::uint64_t frame_ = 0;
   bool send_full_ = true;                     // next update carries full arrays
   std::vector<LoadedBrick> staged_;           // loaded, waiting for budget or a free slot

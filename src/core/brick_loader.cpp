@@ -10,6 +10,7 @@ namespace resoct {
 
 bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept {
   if (a.key.level() != b.key.level()) return a.key.level() > b.key.level();
+  if (a.rank != b.rank) return a.rank < b.rank;
   if (a.since != b.since) return a.since < b.since;
   if (a.hits != b.hits) return a.hits > b.hits;
   return a.key < b.key;
@@ -126,7 +127,7 @@ void BrickLoader::load_one(const LoadRequest& r) {
     std::lock_guard lock(mutex_);
     in_flight_.erase(r.key);
     if (result) {
-      ready_[r.key] = LoadedBrick{result, r.hits, r.since};
+      ready_[r.key] = LoadedBrick{result, r.hits, r.since, r.rank};
       ++(from_cache ? stats_.host_hits : stats_.loads);
     } else if (failed_.insert(r.key).second) {
       new_failures_.push_back(LoadFailure{r.key, std::move(failure)});

@@ -105,6 +105,17 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
 Renderer::~Renderer() = default;
 
 void Renderer::assign_channels(const Scene& scene) {
+  // Load priority among channels: ascending importance, ties in scene order.
+  std::vector<std::size_t> order(scene.channels.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return scene.channels[a].importance < scene.channels[b].importance;
+  });
+  channel_rank_.assign(hierarchy_.volume().channels, std::uint32_t(order.size()));
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    channel_rank_[scene.channels[order[r]].channel] = std::uint32_t(r);
+  }
+
   const std::uint32_t slots = channels_.slot_count();
   std::vector<bool> wanted_slot(slots, false);
   std::vector<std::uint32_t> missing;
@@ -296,7 +307,7 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
       const auto w = waiting_since_.find(k);
       const std::uint64_t since = w == waiting_since_.end() ? frame_ : w->second;
       still_waiting.emplace(k, since);
-      wanted.push_back(LoadRequest{k, resolved.hits[i], since});
+      wanted.push_back(LoadRequest{k, resolved.hits[i], since, channel_rank_[key.channel()]});
       if (j > 0) ++stats.ancestor_requests;
     }
   }

@@ -206,15 +206,18 @@ TEST(BrickLoader, ThreadsReadEveryKeyExactlyOnce) {
   EXPECT_TRUE(loader.idle());
 }
 
-TEST(BrickLoader, OlderRequestsOfALevelGoFirst) {
+TEST(BrickLoader, LowerRankThenOlderRequestsOfALevelGoFirst) {
   auto src = std::make_shared<RecordingSource>();
   BrickLoader loader(src, 0, 1 << 20);
   const BrickKey young(0, 0, {0, 0, 0}), old(0, 0, {3, 3, 1}), coarse(1, 0, {1, 1, 0});
   // Age beats hits and key within a level; a coarser level beats age.
-  const std::vector<LoadRequest> reqs{{young, 50, 9}, {old, 1, 2}, {coarse, 1, 9}};
+  const BrickKey important(0, 1, {2, 2, 1});
+  // Rank beats age within a level.
+  const std::vector<LoadRequest> reqs{
+      {young, 50, 9, 1}, {old, 1, 2, 1}, {coarse, 1, 9, 1}, {important, 1, 20, 0}};
   loader.request(reqs);
   loader.run_queued(10);
-  EXPECT_EQ(src->reads(), (std::vector<BrickKey>{coarse, old, young}));
+  EXPECT_EQ(src->reads(), (std::vector<BrickKey>{coarse, important, old, young}));
 }
 
 TEST(BrickLoader, RejectsBadParameters) {

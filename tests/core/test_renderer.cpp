@@ -162,6 +162,42 @@ TEST(Renderer, RejectsBadOptionsAndScenes) {
                       "max_frames");
 }
 
+TEST(Renderer, MoreImportantChannelsLoadFirstWithinALevel) {
+  auto src = make_test_source();
+  register_test_backend();
+  RendererOptions o = test_options(64, 3);
+  o.visible_slots = 2;
+  Renderer r(src, o);
+  RecordingBackend* b = last_recording_backend();
+  b->set_script([&](const FrameTables& t, FrameResult& res, RecordingBackend& rb) {
+    for (const auto& slot : t.slots)
+      rb.want(r.page_table(), level0_bricks(r.hierarchy(), slot.slot), res);
+  });
+  Scene scene = test_scene(0);
+  scene.channels.push_back(test_scene(2).channels[0]);
+  scene.channels[1].importance = -1;  // channel 2 before channel 0
+  r.render_frame(scene);  // requests; loads 3 bricks: level 2 of both channels, then level 1
+  r.render_frame(scene);  // applies them
+  auto level1_set = [&](std::uint32_t channel) {
+    const std::uint32_t slot = *r.channel_map().slot_of(channel);
+    int n = 0;
+    for (std::uint32_t z = 0; z < 2; ++z)
+      for (std::uint32_t y = 0; y < 2; ++y)
+        for (std::uint32_t x = 0; x < 2; ++x) {
+          n += r.page_table().entry(PageAddress{slot, 1, {x, y, z}}) !=
+                       kernel::RESOCT_PAGE_UNMAPPED_WORD
+                   ? 1
+                   : 0;
+        }
+    return n;
+  };
+  EXPECT_EQ(level1_set(2), 1);
+  EXPECT_EQ(level1_set(0), 0);
+  EXPECT_NE(r.page_table().entry(PageAddress{*r.channel_map().slot_of(0), 2, {0, 0, 0}}),
+            kernel::RESOCT_PAGE_UNMAPPED_WORD);
+  EXPECT_EQ(check_state(r, *b, *src), "");
+}
+
 TEST(Renderer, ExampleScenesFitTheirProceduralDatasets) {
   const char* names[] = {"tubes", "noisefloor", "turbulence", "mandelbulb",
                          "cells", "constant",   "ramp",       "sphere"};
