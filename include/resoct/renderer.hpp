@@ -51,7 +51,9 @@ struct RendererOptions {
   std::uint32_t loader_threads = std::max(1u, std::thread::hardware_concurrency());
   std::uint32_t brick_request_capacity = 1u << 16;
   std::uint32_t node_request_capacity = 1u << 14;
-  std::uint32_t max_node_answers = 4096;    ///< node metadata records supplied per frame
+  /// Node metadata records (node x assigned slot) supplied per frame; bounds the host time per
+  /// frame (a procedural region_meta costs a few microseconds).
+  std::uint32_t max_node_answers = 16384;
   std::uint32_t max_iterations = 1u << 20;  ///< march iterations per ray (cap)
   std::uint32_t start_depth = 2;
   /// Throws Error(invalid_argument) naming the field.
