@@ -13,10 +13,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "resoct/brick_store.hpp"
 #include "resoct/error.hpp"
 #include "resoct/file_io.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/open_source.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
 #include "support/tool_main.hpp"
@@ -44,11 +43,6 @@ struct Args {
   std::string strategy = "greedy";
   std::uint32_t leaf = 16;
 };
-
-std::shared_ptr<const BrickSource> open_volume(const std::string& spec) {
-  if (spec.rfind("procedural:", 0) == 0) return make_procedural_source(spec);
-  return std::make_shared<BrickStoreSource>(spec);
-}
 
 RequestStrategy parse_strategy(const std::string& s) {
   if (s == "greedy") return RequestStrategy::greedy;
@@ -140,7 +134,7 @@ int run(const Args& a) {
   Scene scene = load_scene(a.scene);
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
-  Renderer renderer(open_volume(a.volume), o);
+  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume)), o);
   renderer.set_failure_callback([](const LoadFailure& f) {
     std::fprintf(stderr, "resoct-render: warning: %s\n", f.message.c_str());
   });
@@ -197,8 +191,7 @@ int run(const Args& a) {
 int main(int argc, char** argv) {
   CLI::App app{"Render a volume with the residency octree renderer"};
   Args a;
-  app.add_option("--volume", a.volume, "brick store path or procedural:NAME[:WxHxD[:channels]]")
-      ->required();
+  app.add_option("--volume", a.volume, std::string(kSourceSpecForms))->required();
   app.add_option("--scene", a.scene, "scene JSON (docs/scene.md)")->required();
   app.add_option("--backend", a.backend, "registered backend name")->capture_default_str();
   app.add_option("--mode", a.mode, "residency | pagetable | octree")->capture_default_str();
