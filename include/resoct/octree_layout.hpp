@@ -86,6 +86,11 @@ class OctreeLayout {
   Box3 node_box(std::uint64_t node) const;
   Box3 node_box(std::uint32_t d, const glm::uvec3& c) const;
 
+  /// The level-0 voxels whose values a level-0 trilinear sample inside the node can read: the
+  /// node box grown by one voxel per side, clamped to the volume. Node metadata must be queried
+  /// over this box, or culling and the homogeneous shortcut disagree with sampling near faces.
+  Box3 sampling_support(std::uint64_t node) const;
+
   /// Parent of a node, kNoNode for the root.
   std::uint64_t parent(std::uint64_t node) const;
   /// First child and child count of a node; count 0 for leaves.

@@ -194,4 +194,12 @@ NodeCoordRange OctreeLayout::node_range(std::uint32_t d, const Box3& level0) con
   return r;
 }
 
+Box3 OctreeLayout::sampling_support(std::uint64_t node) const {
+  Box3 box = node_box(node);
+  if (box.empty()) return box;
+  box.lo = glm::max(box.lo - glm::i64vec3(1), glm::i64vec3(0));
+  box.hi = glm::min(box.hi + glm::i64vec3(1), glm::i64vec3(extent0_));
+  return box;
+}
+
 }  // namespace resoct

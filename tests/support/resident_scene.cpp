@@ -67,13 +67,8 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
       const OctreeDepth& d = layout_.depth(depth);
       layout_.for_each_node(depth, NodeCoordRange{glm::uvec3(0), d.count},
                             [&](std::uint64_t node, const glm::uvec3&) {
-                              Box3 box = layout_.node_box(node);
+                              const Box3 box = layout_.sampling_support(node);
                               if (box.empty()) return;
-                              // Trilinear samples inside a node read voxels up to one voxel
-                              // beyond it: the metadata covers that support, so culling and
-                              // the homogeneous shortcut agree with sampling.
-                              box.lo = glm::max(box.lo - glm::i64vec3(1), glm::i64vec3(0));
-                              box.hi = glm::min(box.hi + glm::i64vec3(1), glm::i64vec3(vol.extent));
                               octree_->node_metadata(s, node, source.region_meta(c, box));
                             });
     }

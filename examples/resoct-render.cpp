@@ -1,0 +1,216 @@
+// resoct-render: renders a scene of a volume (brick store or procedural) with the residency
+// octree renderer and writes the image as PNG and the frame statistics as JSON.
+//
+//   resoct-render --volume procedural:tubes --scene examples/scenes/tubes.json
+//                 --out tubes.png --stats tubes.json --converge   (one command line)
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "resoct/error.hpp"
+#include "resoct/file_io.hpp"
+#include "resoct/open_source.hpp"
+#include "resoct/renderer.hpp"
+#include "resoct/scene.hpp"
+#include "support/tool_main.hpp"
+#include "resoct/cpu/cpu_backend.hpp"
+
+namespace {
+
+using namespace resoct;
+
+struct Args {
+  std::string volume;
+  std::string scene;
+  std::string backend = "cpu";
+  std::string mode = "residency";
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::string out;
+  std::string stats;
+  std::uint32_t frames = 0;
+  bool converge = false;
+  std::uint32_t max_frames = 1000;
+  std::uint32_t steady_frames = 5;
+  std::uint64_t cache_mb = 512;
+  std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
+  std::string strategy = "greedy";
+  std::uint32_t leaf = 16;
+};
+
+RequestStrategy parse_strategy(const std::string& s) {
+  if (s == "greedy") return RequestStrategy::greedy;
+  if (s == "global") return RequestStrategy::global;
+  throw invalid_parameter("strategy", "'" + s + "' is not one of greedy, global");
+}
+
+/// Totals over all frames rendered.
+struct Totals {
+  std::uint64_t requests = 0;
+  std::uint64_t dropped = 0;
+  std::uint64_t cap_hits = 0;
+  std::uint64_t uploaded = 0;
+  std::uint64_t bytes_uploaded = 0;
+  std::vector<LoadFailure> failures;
+  void add(const FrameReport& r) {
+    requests += r.stats.brick_requests + r.stats.node_requests;
+    dropped += r.stats.backend.requests_dropped;
+    cap_hits += r.stats.backend.cap_hits;
+    uploaded += r.stats.bricks_uploaded;
+    bytes_uploaded += r.stats.bytes_uploaded;
+    failures.insert(failures.end(), r.failures.begin(), r.failures.end());
+  }
+};
+
+double per_ray(std::uint64_t v, std::uint64_t rays) {
+  return rays == 0 ? 0.0 : double(v) / double(rays);
+}
+
+void write_stats(const std::string& path, const Args& a, const FrameReport& last,
+                 std::uint32_t frames, bool converged, double steady_ms, std::uint32_t steady_count,
+                 const Totals& t, const Renderer& r) {
+  const FrameStats& s = last.stats;
+  nlohmann::json j;
+  j["volume"] = a.volume;
+  j["scene"] = a.scene;
+  j["backend"] = a.backend;
+  j["mode"] = a.mode;
+  j["strategy"] = a.strategy;
+  j["width"] = last.image.width();
+  j["height"] = last.image.height();
+  j["frames"] = frames;
+  j["converged"] = converged;
+  j["ms_per_frame_steady"] = steady_ms;
+  j["steady_frames"] = steady_count;
+  j["ms_render_last"] = s.ms_render;
+  j["ms_device_last"] = s.backend.ms_device;
+  j["rays"] = s.backend.rays;
+  j["samples_per_ray"] = per_ray(s.backend.samples, s.backend.rays);
+  j["nodes_per_ray"] = per_ray(s.backend.nodes_visited, s.backend.rays);
+  j["iterations_per_ray"] = per_ray(s.backend.iterations, s.backend.rays);
+  j["brick_accesses_per_ray"] = per_ray(s.backend.brick_accesses, s.backend.rays);
+  j["bricks_touched"] = s.working_set_bricks;
+  j["working_set_bytes"] = s.working_set_bytes;
+  j["resident_bricks"] = s.resident_bricks;
+  j["cache_slots"] = r.cache().slot_count();
+  j["requests_total"] = t.requests;
+  j["requests_dropped"] = t.dropped;
+  j["cap_hits"] = t.cap_hits;
+  j["bricks_uploaded"] = t.uploaded;
+  j["bytes_uploaded"] = t.bytes_uploaded;
+  j["loads"] = r.loader().stats().loads;
+  j["host_cache_hits"] = r.loader().stats().host_hits;
+  nlohmann::json f = nlohmann::json::array();
+  for (const LoadFailure& x : t.failures) f.push_back(x.message);
+  j["load_failures"] = f;
+  const std::string text = j.dump(2) + "\n";
+  AtomicFileWriter w(path);
+  w.append(std::as_bytes(std::span(text.data(), text.size())));
+  w.commit();
+}
+
+int run(const Args& a) {
+  resoct::cpu::register_backend();
+  RendererOptions o;
+  o.backend = a.backend;
+  o.mode = parse_render_mode(a.mode);
+  o.strategy = parse_strategy(a.strategy);
+  if (a.cache_mb == 0 || a.cache_mb > (std::uint64_t(1) << 24)) {
+    throw invalid_parameter("cache-mb", "must be 1..2^24");
+  }
+  o.device_cache_bytes = a.cache_mb << 20;
+  o.loader_threads = a.threads;
+  if (a.leaf == 0) throw invalid_parameter("leaf", "must be > 0");
+  o.leaf_size = glm::uvec3(a.leaf);
+  if (a.frames == 0 && !a.converge)
+    throw invalid_parameter("frames", "give --frames N or --converge");
+
+  Scene scene = load_scene(a.scene);
+  if (a.width != 0) scene.viewport.width = a.width;
+  if (a.height != 0) scene.viewport.height = a.height;
+  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume)), o);
+  renderer.set_failure_callback([](const LoadFailure& f) {
+    std::fprintf(stderr, "resoct-render: warning: %s\n", f.message.c_str());
+  });
+
+  Totals totals;
+  FrameReport last;
+  std::uint32_t frames = 0;
+  bool converged = false;
+  auto frame = [&] {
+    last = renderer.render_frame(scene);
+    ++frames;
+    totals.add(last);
+    std::fprintf(stderr, "%s\n", format_frame_line(last.stats).c_str());
+    return last.converged;
+  };
+  std::vector<double> ms;  // render_frame wall time of every frame
+  if (a.converge) {
+    while (frames < a.max_frames && !(converged = frame())) {
+      ms.push_back(last.stats.ms_frame);
+      // Frames while loads run would only re-render the same state; wait for them.
+      renderer.wait_for_loads();
+    }
+    ms.push_back(last.stats.ms_frame);
+    // Steady state: extra frames after convergence, which load and upload nothing.
+    for (std::uint32_t i = 0; converged && i < a.steady_frames; ++i) {
+      frame();
+      ms.push_back(last.stats.ms_frame);
+    }
+  } else {
+    for (std::uint32_t i = 0; i < a.frames; ++i) {
+      converged = frame();
+      ms.push_back(last.stats.ms_frame);
+    }
+  }
+  // ms_per_frame_steady: mean over the last steady_frames frames (the extra frames after
+  // convergence with --converge); fewer when fewer were rendered.
+  const std::size_t n = std::min<std::size_t>(ms.size(), a.steady_frames);
+  double steady = 0.0;
+  for (std::size_t i = ms.size() - n; i < ms.size(); ++i) steady += ms[i];
+  if (n != 0) steady /= double(n);
+  const std::uint32_t tail = std::uint32_t(n);
+
+  if (!a.out.empty()) write_png(last.image, a.out);
+  if (!a.stats.empty()) {
+    write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer);
+  }
+  std::fprintf(stderr, "resoct-render: %u frames, %s, %.2f ms/frame steady\n", frames,
+               converged ? "converged" : "not converged", steady);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Render a volume with the residency octree renderer"};
+  Args a;
+  app.add_option("--volume", a.volume, std::string(kSourceSpecForms))->required();
+  app.add_option("--scene", a.scene, "scene JSON (docs/scene.md)")->required();
+  app.add_option("--backend", a.backend, "registered backend name")->capture_default_str();
+  app.add_option("--mode", a.mode, "residency | pagetable | octree")->capture_default_str();
+  app.add_option("--width", a.width, "image width (overrides the scene viewport)");
+  app.add_option("--height", a.height, "image height (overrides the scene viewport)");
+  app.add_option("--out", a.out, "output PNG");
+  app.add_option("--stats", a.stats, "output statistics JSON");
+  auto* frames = app.add_option("--frames", a.frames, "render exactly N frames");
+  app.add_flag("--converge", a.converge, "render until converged (capped by --max-frames)")
+      ->excludes(frames);
+  app.add_option("--max-frames", a.max_frames, "frame cap of --converge")->capture_default_str();
+  app.add_option("--steady-frames", a.steady_frames, "frames averaged for ms_per_frame_steady")
+      ->capture_default_str();
+  app.add_option("--cache-mb", a.cache_mb, "device brick cache in MiB")->capture_default_str();
+  app.add_option("--threads", a.threads, "loader threads (0 = load synchronously)")
+      ->capture_default_str();
+  app.add_option("--strategy", a.strategy, "greedy | global")->capture_default_str();
+  app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  return resoct::tools::run_tool("resoct-render", [&] { return run(a); });
+}

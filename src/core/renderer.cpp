@@ -1,0 +1,420 @@
+#include "resoct/renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "resoct/error.hpp"
+#include "resoct/frame_tables.hpp"
+#include "resoct/kernel/page_entry.glsl.h"
+
+namespace resoct {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+const BrickSource& checked_source(const std::shared_ptr<const BrickSource>& s) {
+  if (!s) throw invalid_parameter("source", "must not be null");
+  return *s;
+}
+
+std::uint32_t slot_count_for(const RendererOptions& o, const BrickSource& s) {
+  if (o.visible_slots != 0) return o.visible_slots;
+  return std::min(s.volume().channels, kernel::RESOCT_MAX_SLOTS);
+}
+
+std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, const BrickHierarchy& h,
+                                            const glm::dvec3* camera) {
+  if (name == "lru") return std::make_unique<LruPolicy>();
+  if (name == "octreemizer") {
+    // Distances in physical units from the camera of the frame being rendered.
+    return std::make_unique<OctreemizerPolicy>(
+        h.level_count(), OctreemizerWeights{},
+        [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
+  }
+  throw invalid_parameter("eviction", "'" + name + "' is not one of lru, octreemizer");
+}
+
+bool page_unmapped(std::uint32_t entry) {
+  return kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED;
+}
+
+}  // namespace
+
+void RendererOptions::validate() const {
+  if (backend.empty()) throw invalid_parameter("backend", "must not be empty");
+  if (visible_slots > kernel::RESOCT_MAX_SLOTS) {
+    throw invalid_parameter("visible_slots", "must be at most RESOCT_MAX_SLOTS (32)");
+  }
+  if (device_cache_bytes == 0) throw invalid_parameter("device_cache_bytes", "must be > 0");
+  if (upload_budget.max_bricks == 0 || upload_budget.max_bytes == 0) {
+    throw invalid_parameter("upload_budget", "bricks and bytes per frame must be > 0");
+  }
+  if (ttl == 0) throw invalid_parameter("ttl", "must be >= 1");
+  if (eviction != "lru" && eviction != "octreemizer") {
+    throw invalid_parameter("eviction", "'" + eviction + "' is not one of lru, octreemizer");
+  }
+  if (loader_threads > 1024) throw invalid_parameter("loader_threads", "must be at most 1024");
+  if (brick_request_capacity == 0 || brick_request_capacity > (1u << 28)) {
+    throw invalid_parameter("brick_request_capacity", "must be 1..2^28");
+  }
+  if (node_request_capacity == 0 || node_request_capacity > (1u << 28)) {
+    throw invalid_parameter("node_request_capacity", "must be 1..2^28");
+  }
+  if (max_node_answers == 0) throw invalid_parameter("max_node_answers", "must be > 0");
+  if (max_iterations == 0) throw invalid_parameter("max_iterations", "must be > 0");
+}
+
+Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions options)
+    : source_(std::move(source)),
+      options_((options.validate(), std::move(options))),
+      hierarchy_(checked_source(source_).hierarchy()),
+      layout_(hierarchy_.volume().extent, options_.leaf_size),
+      pages_(hierarchy_, slot_count_for(options_, *source_)),
+      channels_(pages_.slot_count(), hierarchy_.volume().channels) {
+  cache_ = std::make_unique<BrickCache>(hierarchy_.layout(), hierarchy_.volume().type,
+                                        options_.device_cache_bytes, options_.ttl,
+                                        make_policy(options_.eviction, hierarchy_, &camera_));
+  // Residency means "sampling needs no cache miss": EMPTY and HOMOGENEOUS entries qualify as
+  // well as MAPPED ones, so the traversal may use such a level without touching the cache.
+  octree_ = std::make_unique<ResidencyOctree>(
+      hierarchy_, layout_, pages_.slot_count(),
+      [this](std::uint32_t slot, std::uint32_t level, glm::uvec3 brick) {
+        return !page_unmapped(pages_.entry(PageAddress{slot, level, brick}));
+      });
+  loader_ =
+      std::make_unique<BrickLoader>(source_, options_.loader_threads, options_.host_cache_bytes);
+  backend_ = create_backend(options_.backend, options_.backend_options);
+  config_.voxel_type = hierarchy_.volume().type;
+  config_.padded_brick = hierarchy_.layout().padded_size();
+  config_.cache_slots = cache_->slot_count();
+  config_.page_entries = std::uint32_t(pages_.entries().size());
+  config_.page_tables = pages_.table_count();
+  config_.node_words = octree_->words().size();
+  config_.brick_request_capacity = options_.brick_request_capacity;
+  config_.node_request_capacity = options_.node_request_capacity;
+  backend_->configure(config_);
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::assign_channels(const Scene& scene) {
+  // Load priority among channels: ascending importance, ties in scene order.
+  std::vector<std::size_t> order(scene.channels.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return scene.channels[a].importance < scene.channels[b].importance;
+  });
+  channel_rank_.assign(hierarchy_.volume().channels, std::uint32_t(order.size()));
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    channel_rank_[scene.channels[order[r]].channel] = std::uint32_t(r);
+  }
+
+  const std::uint32_t slots = channels_.slot_count();
+  std::vector<bool> wanted_slot(slots, false);
+  std::vector<std::uint32_t> missing;
+  for (const ChannelSettings& c : scene.channels) {
+    if (auto s = channels_.slot_of(c.channel)) {
+      wanted_slot[*s] = true;
+    } else {
+      missing.push_back(c.channel);
+    }
+  }
+  // Slots of channels the scene no longer shows keep their bricks until a new channel needs the
+  // slot, so toggling a channel off and on again costs nothing. Unassigned slots go first.
+  std::vector<std::uint32_t> free_slots;
+  for (std::uint32_t s = 0; s < slots; ++s) {
+    if (!wanted_slot[s] && !channels_.channel(s)) free_slots.push_back(s);
+  }
+  for (std::uint32_t s = 0; s < slots; ++s) {
+    if (!wanted_slot[s] && channels_.channel(s)) free_slots.push_back(s);
+  }
+  for (std::size_t i = 0; i < missing.size(); ++i) {
+    const std::uint32_t slot = free_slots.at(i);  // count checked by render_frame
+    SlotRemap remap = channels_.assign(slot, missing[i], pages_);
+    for (std::uint32_t cs : remap.released_cache_slots) cache_->release(cs);
+    octree_->remap_slot(slot, hierarchy_.volume().range(missing[i]));
+  }
+}
+
+void Renderer::evict(BrickKey key) {
+  const auto addr = channels_.address_of(key);
+  if (!addr) return;  // released with its slot already
+  pages_.set_unmapped(*addr);
+  octree_->brick_evicted(addr->slot, addr->level, addr->brick);
+}
+
+bool Renderer::apply_one(const LoadedBrick& b, FrameStats& stats) {
+  const HostBrick& hb = *b.brick;
+  const PageAddress addr = *channels_.address_of(hb.key);
+  if (hb.meta.constant) {
+    // A brick of only NaN (min = +inf) has nothing to sample either; it is mapped EMPTY.
+    if (hb.meta.all_zero() || !(hb.meta.min <= hb.meta.max)) {
+      pages_.set_empty(addr);
+      ++stats.pages_empty;
+    } else {
+      pages_.set_homogeneous(addr, hb.meta.min, hierarchy_.volume().range(hb.key.channel()));
+      ++stats.pages_homogeneous;
+    }
+    octree_->brick_added(addr.slot, addr.level, addr.brick);
+    return true;
+  }
+  const auto ins = cache_->insert(hb.key);
+  if (!ins) {
+    ++stats.insert_failures;
+    return false;
+  }
+  if (ins->evicted) {
+    evict(*ins->evicted);
+    ++stats.evictions;
+  }
+  pages_.set_mapped(addr, ins->slot);
+  octree_->brick_added(addr.slot, addr.level, addr.brick);
+  uploads_.push_back(BrickUpload{ins->slot, hb.voxels});
+  upload_data_.push_back(b.brick);
+  ++stats.bricks_uploaded;
+  stats.bytes_uploaded += hb.voxels.size();
+  return true;
+}
+
+void Renderer::apply_loaded(FrameStats& stats) {
+  std::vector<LoadedBrick> fresh = loader_->take_ready();
+  std::unordered_set<BrickKey> seen;
+  std::vector<LoadedBrick> all;
+  all.reserve(staged_.size() + fresh.size());
+  for (auto* list : {&staged_, &fresh}) {
+    for (LoadedBrick& b : *list) {
+      if (seen.insert(b.brick->key).second) all.push_back(std::move(b));
+    }
+  }
+  staged_.clear();
+  std::sort(all.begin(), all.end(), [](const LoadedBrick& a, const LoadedBrick& b) {
+    return load_before(a.request(), b.request());
+  });
+
+  // Constant bricks only change a page entry, so they bypass the upload budget; the others are
+  // admitted in priority order while the bricks and bytes of the budget last.
+  std::vector<UploadCandidate> candidates;
+  std::vector<const LoadedBrick*> candidate_bricks;
+  for (const LoadedBrick& b : all) {
+    const auto addr = channels_.address_of(b.brick->key);
+    if (!addr || !page_unmapped(pages_.entry(*addr))) {
+      ++stats.stale_loads;  // channel left the visible slots, or mapped meanwhile
+      continue;
+    }
+    if (b.brick->meta.constant) {
+      apply_one(b, stats);
+      continue;
+    }
+    candidates.push_back(UploadCandidate{b.brick->key, cache_->slot_bytes()});
+    candidate_bricks.push_back(&b);
+  }
+  const UploadPlan plan = plan_uploads(candidates, options_.upload_budget);
+  std::size_t i = 0;
+  for (; i < plan.admitted.size(); ++i) {
+    // Every slot pinned: the rest waits for pins to expire (uploads pin for ttl frames only).
+    if (!apply_one(*candidate_bricks[i], stats)) break;
+  }
+  for (; i < candidate_bricks.size(); ++i) staged_.push_back(*candidate_bricks[i]);
+  // Waiting bricks beyond what the cache could hold are dropped (worst first); they stay in the
+  // host cache, so a renewed request is cheap.
+  const std::size_t keep = std::max<std::size_t>(cache_->slot_count(), 64);
+  if (staged_.size() > keep) staged_.resize(keep);
+  stats.uploads_deferred = staged_.size();
+}
+
+void Renderer::answer_nodes(FrameStats& stats) {
+  std::uint64_t answered = 0;
+  for (std::uint32_t node : pending_nodes_) {
+    if (node >= layout_.node_count()) continue;  // device data is not trusted
+    const Box3 box = layout_.sampling_support(node);
+    if (box.empty()) continue;
+    for (std::uint32_t s = 0; s < channels_.slot_count(); ++s) {
+      const auto ch = channels_.channel(s);
+      if (!ch) continue;
+      if (answered >= options_.max_node_answers) break;
+      octree_->node_metadata(s, node, source_->region_meta(*ch, box));
+      ++answered;
+    }
+    if (answered >= options_.max_node_answers) break;
+  }
+  pending_nodes_.clear();
+  stats.nodes_answered = answered;
+}
+
+void Renderer::send_update(FrameStats& stats) {
+  FrameUpdate u;
+  u.bricks = uploads_;
+  const std::vector<PageDelta> page_deltas = pages_.take_deltas();
+  // Past a quarter of the table a full upload is cheaper than scattering deltas.
+  if (send_full_ || page_deltas.size() > pages_.entries().size() / 4) {
+    u.pages_full = true;
+    u.all_pages = pages_.entries();
+    u.page_table_offsets = pages_.table_offsets();
+    stats.page_deltas = pages_.entries().size();
+  } else {
+    u.page_deltas = page_deltas;
+    stats.page_deltas = page_deltas.size();
+  }
+  const OctreeDeltas node_deltas = octree_->take_deltas();
+  if (send_full_ || node_deltas.full) {
+    u.nodes_full = true;
+    u.all_nodes = octree_->words();
+    stats.node_deltas = octree_->words().size();
+  } else {
+    u.node_deltas = node_deltas.words;
+    stats.node_deltas = node_deltas.words.size();
+  }
+  stats.pages_full = u.pages_full;
+  stats.nodes_full = u.nodes_full;
+  backend_->update(u);
+  send_full_ = false;
+  uploads_.clear();
+  upload_data_.clear();
+}
+
+bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats) {
+  const ResolvedRequests resolved = channels_.resolve(result.brick_requests, epoch, pages_);
+  stats.brick_requests = result.brick_requests.size();
+  stats.stale_requests = resolved.stale;
+  stats.node_requests = result.node_requests.size();
+
+  std::unordered_set<BrickKey> skip;
+  for (const LoadedBrick& b : staged_) skip.insert(b.brick->key);
+  std::vector<LoadRequest> wanted;
+  std::unordered_map<BrickKey, std::uint64_t> still_waiting;
+  bool outstanding = false;
+  const auto available = [this](const PageAddress& a) { return !page_unmapped(pages_.entry(a)); };
+  for (std::size_t i = 0; i < resolved.bricks.size(); ++i) {
+    const BrickKey key = resolved.bricks[i];
+    if (loader_->has_failed(key)) {
+      ++stats.failed_requests;
+      continue;
+    }
+    outstanding = true;
+    const PageAddress target = *channels_.address_of(key);
+    const auto chain = bricks_to_request(hierarchy_, target, options_.strategy, available);
+    for (std::size_t j = 0; j < chain.size(); ++j) {
+      const BrickKey k(chain[j].level, key.channel(), chain[j].brick);
+      if (j > 0 && loader_->has_failed(k)) continue;
+      if (!page_unmapped(pages_.entry(chain[j])) || !skip.insert(k).second) continue;
+      const auto w = waiting_since_.find(k);
+      const std::uint64_t since = w == waiting_since_.end() ? frame_ : w->second;
+      still_waiting.emplace(k, since);
+      wanted.push_back(LoadRequest{k, resolved.hits[i], since, channel_rank_[key.channel()]});
+      if (j > 0) ++stats.ancestor_requests;
+    }
+  }
+  waiting_since_ = std::move(still_waiting);
+  loader_->request(wanted);
+  if (loader_->thread_count() == 0) {
+    const std::uint64_t n =
+        std::min<std::uint64_t>(wanted.size(), options_.upload_budget.max_bricks);
+    loader_->run_queued(std::size_t(n));
+  }
+  stats.loads_queued = loader_->queued();
+  stats.loads_in_flight = loader_->in_flight();
+
+  pending_nodes_.clear();
+  for (const Request& r : result.node_requests) pending_nodes_.push_back(r.key);
+  return outstanding || !pending_nodes_.empty() || result.stats.requests_dropped != 0;
+}
+
+void Renderer::report_failures(FrameReport& report) {
+  report.failures = loader_->take_failures();
+  report.stats.new_failures = report.failures.size();
+  if (on_failure_) {
+    for (const LoadFailure& f : report.failures) on_failure_(f);
+  }
+}
+
+FrameTables Renderer::frame_tables(const Scene& scene) const {
+  FrameOptions fo;
+  fo.mode = options_.mode;
+  fo.frame_index = std::uint32_t(frame_);
+  fo.request_strategy = options_.strategy;
+  fo.start_depth = options_.start_depth;
+  fo.max_iterations = options_.max_iterations;
+  return build_frame_tables(scene, hierarchy_, layout_, channels_, fo);
+}
+
+FrameReport Renderer::render_frame(const Scene& scene) {
+  const auto t_frame = Clock::now();
+  scene.validate(hierarchy_.volume(), "scene");
+  if (scene.channels.size() > channels_.slot_count()) {
+    throw invalid_parameter("scene", std::to_string(scene.channels.size()) +
+                                         " channels exceed the renderer's " +
+                                         std::to_string(channels_.slot_count()) + " visible slots");
+  }
+  ++frame_;
+  cache_->begin_frame(frame_);
+  {
+    // Box space has its longest physical axis spanning [0, 1] (docs/scene.md).
+    const glm::dvec3 phys = physical_size(hierarchy_.volume());
+    camera_ = scene.camera.eye * std::max({phys.x, phys.y, phys.z});
+  }
+  FrameReport report;
+  FrameStats& stats = report.stats;
+  stats.frame_index = frame_;
+
+  auto t = Clock::now();
+  assign_channels(scene);
+  apply_loaded(stats);
+  answer_nodes(stats);
+  stats.ms_upload = ms_since(t);
+
+  t = Clock::now();
+  send_update(stats);
+  stats.ms_update = ms_since(t);
+
+  t = Clock::now();
+  const std::uint64_t epoch = channels_.epoch();
+  backend_->render(frame_tables(scene), result_);
+  stats.ms_render = ms_since(t);
+  stats.backend = result_.stats;
+
+  t = Clock::now();
+  // Bricks sampled this frame count as used now; the next frame's uploads may evict them
+  // (unless pinned by ttl), which is what lets a cache smaller than the working set progress.
+  std::unordered_set<std::uint32_t> used;
+  for (std::uint32_t s : result_.used_cache_slots) {
+    if (s < cache_->slot_count() && cache_->key_of(s) && used.insert(s).second) cache_->touch(s);
+  }
+  stats.working_set_bricks = used.size();
+  stats.working_set_bytes = used.size() * cache_->slot_bytes();
+  const bool outstanding = handle_requests(result_, epoch, stats);
+  stats.ms_requests = ms_since(t);
+  report_failures(report);
+  stats.resident_bricks = cache_->resident_count();
+
+  report.converged = !outstanding && staged_.empty() && loader_->idle();
+  report.image = std::move(result_.image);
+  result_.image = Image();
+  stats.ms_frame = ms_since(t_frame);
+  return report;
+}
+
+ConvergeReport Renderer::render_until_converged(const Scene& scene, std::uint32_t max_frames) {
+  if (max_frames == 0) throw invalid_parameter("max_frames", "must be >= 1");
+  ConvergeReport out;
+  std::vector<LoadFailure> failures;
+  for (out.frames = 1;; ++out.frames) {
+    out.last = render_frame(scene);
+    failures.insert(failures.end(), out.last.failures.begin(), out.last.failures.end());
+    out.converged = out.last.converged;
+    if (out.converged || out.frames >= max_frames) break;
+    // With loader threads, waiting for the requested bricks makes every frame count instead of
+    // re-rendering the same state while the loads run.
+    loader_->wait_idle();
+  }
+  out.last.failures = std::move(failures);
+  return out;
+}
+
+}  // namespace resoct
