@@ -9,9 +9,11 @@
 #include "resoct/open_source.hpp"
 #include "resoct/procedural_source.hpp"
 #include "support/expect_error.hpp"
+#include "support/brick_compare.hpp"
 #include "test_brick_store_util.hpp"
 
 using namespace resoct;
+using resoct::test::expect_same_bricks;
 using resoct::test::TempDir;
 
 namespace {
@@ -20,20 +22,6 @@ BrickLayout small_layout(std::uint32_t b) {
   BrickLayout l;
   l.brick_size = glm::uvec3(b);
   return l;
-}
-
-void expect_same_bricks(const BrickSource& a, const BrickSource& b) {
-  ASSERT_EQ(a.hierarchy(), b.hierarchy());
-  const std::size_t bytes = a.hierarchy().layout().padded_voxels() * voxel_size(a.volume().type);
-  std::vector<std::byte> x(bytes), y(bytes);
-  for (std::uint32_t c = 0; c < a.volume().channels; ++c) {
-    for (std::uint64_t i = 0; i < a.hierarchy().bricks_per_channel(); ++i) {
-      const BrickKey key = a.hierarchy().key_from_linear(c, i);
-      a.read_brick(key, x);
-      b.read_brick(key, y);
-      ASSERT_EQ(std::memcmp(x.data(), y.data(), bytes), 0) << "channel " << c << " brick " << i;
-    }
-  }
 }
 
 TEST(OpenSource, ProceduralSpecUsesTheLayout) {

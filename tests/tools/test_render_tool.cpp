@@ -14,34 +14,17 @@
 #include <nlohmann/json.hpp>
 
 #include "core/test_brick_store_util.hpp"
+#include "support/tool_process.hpp"
 #include "resoct/image.hpp"
 
+using resoct::test::slurp;
 using resoct::test::TempDir;
+using resoct::test::ToolRun;
 
 namespace {
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Runs a tool with stderr captured (not a TTY) and stdout discarded.
 ToolRun run(const TempDir& dir, const std::string& tool, const std::string& args) {
-  const std::string err = dir.file("stderr.txt");
-  const std::string cmd = "'" + tool + "' " + args + " >/dev/null 2>'" + err + "'";
-  const int status = std::system(cmd.c_str());
-  ToolRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err);
-  std::filesystem::remove(err);
-  return r;
+  return resoct::test::run_tool_process(dir.path().string(), tool, args);
 }
 
 std::string scene(const std::string& name) {

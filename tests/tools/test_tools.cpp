@@ -19,46 +19,24 @@
 #include <nlohmann/json.hpp>
 
 #include "core/test_brick_store_util.hpp"
+#include "support/brick_compare.hpp"
+#include "support/tool_process.hpp"
 #include "resoct/brick_store.hpp"
 #include "resoct/hierarchy.hpp"
 #include "resoct/in_memory_source.hpp"
 #include "resoct/procedural_source.hpp"
 
 using namespace resoct;
+using resoct::test::expect_same_bricks;
+using resoct::test::shell_quote;
+using resoct::test::slurp;
 using resoct::test::TempDir;
+using resoct::test::ToolRun;
 
 namespace {
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// Runs `tool args` with stdout and stderr redirected to files (so stderr is not a TTY).
 ToolRun run(const TempDir& dir, const std::string& tool, const std::string& args) {
-  const std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
-  const std::string cmd = quote(tool) + " " + args + " >" + quote(out) + " 2>" + quote(err);
-  const int status = std::system(cmd.c_str());
-  ToolRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  std::filesystem::remove(out);
-  std::filesystem::remove(err);
-  return r;
+  return resoct::test::run_tool_process(dir.path().string(), tool, args);
 }
 
 std::size_t line_count(const std::string& s) {
@@ -74,25 +52,12 @@ BrickLayout layout_of(std::uint32_t b, std::uint32_t halo = 1) {
   return l;
 }
 
-void expect_same_bricks(const BrickSource& a, const BrickSource& b) {
-  ASSERT_EQ(a.hierarchy(), b.hierarchy());
-  const std::size_t bytes = a.hierarchy().layout().padded_voxels() * voxel_size(a.volume().type);
-  std::vector<std::byte> x(bytes), y(bytes);
-  for (std::uint32_t c = 0; c < a.volume().channels; ++c) {
-    for (std::uint64_t i = 0; i < a.hierarchy().bricks_per_channel(); ++i) {
-      const BrickKey key = a.hierarchy().key_from_linear(c, i);
-      a.read_brick(key, x);
-      b.read_brick(key, y);
-      ASSERT_EQ(std::memcmp(x.data(), y.data(), bytes), 0) << "channel " << c << " brick " << i;
-    }
-  }
-}
-
 TEST(Tools, ConvertProceduralIsBitExactAndShowsPlainProgress) {
   TempDir dir;
   const std::string out = dir.file("tubes.rbs");
-  const ToolRun r = run(dir, RESOCT_CONVERT,
-                        "procedural:tubes:64x64x64 " + quote(out) + " --brick 16 --threads 2");
+  const ToolRun r =
+      run(dir, RESOCT_CONVERT,
+          "procedural:tubes:64x64x64 " + shell_quote(out) + " --brick 16 --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("Wrote " + out), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("MB/s"), std::string::npos) << r.out;
@@ -111,7 +76,7 @@ TEST(Tools, ConvertWithZstdMultiChannelAndWideHalo) {
   TempDir dir;
   const std::string out = dir.file("sphere.rbs");
   const ToolRun r = run(dir, RESOCT_CONVERT,
-                        "procedural:sphere:40x30x20:2 " + quote(out) +
+                        "procedural:sphere:40x30x20:2 " + shell_quote(out) +
                             " --codec zstd --level 5 --brick 8x8x8 --halo 2 --metadata-block 8");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const BrickStoreSource store(out);
@@ -125,9 +90,10 @@ TEST(Tools, InfoJsonMatchesTheStore) {
   TempDir dir;
   const std::string out = dir.file("tubes.rbs");
   ASSERT_EQ(
-      run(dir, RESOCT_CONVERT, "procedural:tubes:64x64x64 " + quote(out) + " --brick 16").exit_code,
+      run(dir, RESOCT_CONVERT, "procedural:tubes:64x64x64 " + shell_quote(out) + " --brick 16")
+          .exit_code,
       0);
-  const ToolRun r = run(dir, RESOCT_INFO, quote(out) + " --json");
+  const ToolRun r = run(dir, RESOCT_INFO, shell_quote(out) + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["kind"], "store");
@@ -179,7 +145,7 @@ TEST(Tools, InfoJsonMatchesTheStore) {
   EXPECT_EQ(j["total"]["empty_bricks"], total_empty);
   EXPECT_LT(j["total"]["compressed_bytes"].get<std::uint64_t>(), std::filesystem::file_size(out));
 
-  const ToolRun text = run(dir, RESOCT_INFO, quote(out));
+  const ToolRun text = run(dir, RESOCT_INFO, shell_quote(out));
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("lz4"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("total"), std::string::npos) << text.out;
@@ -228,7 +194,7 @@ TEST(Tools, ConvertRawRoundTrip) {
   const std::string raw = dir.file("cells.raw"), out = dir.file("cells.rbs");
   resoct::test::write_bytes(raw, file);
   const ToolRun r = run(dir, RESOCT_CONVERT,
-                        quote(raw) + " " + quote(out) +
+                        shell_quote(raw) + " " + shell_quote(out) +
                             " --dims 30x20x10 --type u16 --endian big --channels 2 --offset 32"
                             " --spacing 0.5,0.5,2 --range 0,4095 --brick 8 --codec zstd");
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -258,8 +224,8 @@ TEST(Tools, ConvertRawF32TakesItsRangeFromTheData) {
   }
   const std::string raw = dir.file("f.raw"), out = dir.file("f.rbs");
   resoct::test::write_bytes(raw, file);
-  const ToolRun r =
-      run(dir, RESOCT_CONVERT, quote(raw) + " " + quote(out) + " --dims 16x16x16 --type f32");
+  const ToolRun r = run(dir, RESOCT_CONVERT,
+                        shell_quote(raw) + " " + shell_quote(out) + " --dims 16x16x16 --type f32");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const BrickStoreSource store(out);
   EXPECT_EQ(store.volume().range(0), (ValueRange{double(lo), double(hi)}));
@@ -322,13 +288,13 @@ TEST(Tools, ConvertBadInputFailsCleanly) {
 TEST(Tools, InfoOnACorruptedStoreNamesTheFile) {
   TempDir dir;
   const std::string out = dir.file("c.rbs");
-  ASSERT_EQ(
-      run(dir, RESOCT_CONVERT, "procedural:ramp:16x16x16 " + quote(out) + " --brick 8").exit_code,
-      0);
+  ASSERT_EQ(run(dir, RESOCT_CONVERT, "procedural:ramp:16x16x16 " + shell_quote(out) + " --brick 8")
+                .exit_code,
+            0);
   std::vector<std::uint8_t> bytes = resoct::test::read_bytes(out);
   bytes.at(30) ^= 0x40;  // inside the extent field: the header checksum no longer matches
   resoct::test::write_bytes(out, bytes);
-  const ToolRun r = run(dir, RESOCT_INFO, quote(out) + " --json");
+  const ToolRun r = run(dir, RESOCT_INFO, shell_quote(out) + " --json");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(line_count(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find(out), std::string::npos) << r.err;
@@ -336,11 +302,11 @@ TEST(Tools, InfoOnACorruptedStoreNamesTheFile) {
 
   const std::string text = dir.file("readme.txt");
   resoct::test::write_bytes(text, {'h', 'e', 'l', 'l', 'o', '\n'});
-  const ToolRun t = run(dir, RESOCT_INFO, quote(text));
+  const ToolRun t = run(dir, RESOCT_INFO, shell_quote(text));
   EXPECT_NE(t.exit_code, 0);
   EXPECT_EQ(line_count(t.err), 1u) << t.err;
   EXPECT_NE(t.err.find(text), std::string::npos) << t.err;
-  const ToolRun m = run(dir, RESOCT_INFO, quote(dir.file("missing.rbs")));
+  const ToolRun m = run(dir, RESOCT_INFO, shell_quote(dir.file("missing.rbs")));
   EXPECT_NE(m.exit_code, 0);
   EXPECT_NE(m.err.find(dir.file("missing.rbs")), std::string::npos) << m.err;
 }
