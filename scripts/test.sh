@@ -6,5 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/check-format.sh
 bash scripts/build.sh release
-export VK_LOADER_DEBUG="${VK_LOADER_DEBUG:-}"
 ctest --preset release -j "${RESOCT_JOBS:-2}" "$@"
