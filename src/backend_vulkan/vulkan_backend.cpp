@@ -35,12 +35,22 @@ enum Binding : std::uint32_t {
   b_used,
   b_out,
   b_stats,
+  b_cache1,  // cache chunks 1..7 (chunk 0 is b_cache)
+  b_cache7 = b_cache1 + 6,
   binding_count
 };
+
+constexpr std::uint32_t kCacheChunks = 8;
+
+// Binding of cache chunk c.
+Binding cache_binding(std::uint32_t c) {
+  return c == 0 ? b_cache : Binding(b_cache1 + c - 1);
+}
 
 struct PushConstants {
   std::uint32_t brick_capacity, brick_log2_capacity, brick_max_probes;
   std::uint32_t node_capacity, node_log2_capacity, node_max_probes;
+  std::uint32_t slots_per_chunk;
 };
 
 constexpr std::uint32_t kWorkgroup = 8;
@@ -78,6 +88,15 @@ struct VulkanBackend::Impl {
   std::size_t voxel_bytes = 1;
   std::size_t slot_voxels = 0;
   std::uint32_t brick_capacity = 1, node_capacity = 1;
+  std::uint32_t slots_per_chunk = 1;     // cache slots per cache buffer
+  std::uint64_t cache_buffer_limit = 0;  // test override of maxStorageBufferRange (0 = none)
+
+  /// Where cache slot `slot` starts: its chunk's mapping plus the byte offset in it.
+  std::byte* slot_address(std::uint32_t slot) const {
+    const std::uint32_t c = slot / slots_per_chunk;
+    return static_cast<std::byte*>(buf[cache_binding(c)].mapped) +
+           std::size_t(slot - c * slots_per_chunk) * slot_voxels * voxel_bytes;
+  }
 
   explicit Impl(std::unique_ptr<detail::Context> c);
   ~Impl();
@@ -326,10 +345,26 @@ void VulkanBackend::configure(const BackendConfig& config) {
   }
   const std::uint32_t brick_cap = std::bit_ceil(config.brick_request_capacity);
   const std::uint32_t node_cap = std::bit_ceil(config.node_request_capacity);
+  // Whole bricks per cache buffer, so that no brick straddles two buffers.
+  std::uint64_t range = m.ctx->props.limits.maxStorageBufferRange & ~3u;
+  if (m.cache_buffer_limit != 0) range = std::min(range, m.cache_buffer_limit);
+  const std::uint64_t brick_bytes = slot_voxels * vb;
+  if (brick_bytes > range) {
+    throw Error(ErrorCode::out_of_memory, "vulkan: one brick of " + std::to_string(brick_bytes) +
+                                              " bytes exceeds maxStorageBufferRange");
+  }
+  const std::uint32_t slots_per_chunk =
+      std::uint32_t(std::min<std::uint64_t>(range / brick_bytes, std::max(config.cache_slots, 1u)));
+  const std::uint32_t chunks = (config.cache_slots + slots_per_chunk - 1) / slots_per_chunk;
+  if (chunks > kCacheChunks) {
+    throw Error(ErrorCode::out_of_memory,
+                "vulkan: brick cache of " + std::to_string(brick_bytes * config.cache_slots) +
+                    " bytes needs more than " + std::to_string(kCacheChunks) + " buffers of " +
+                    "maxStorageBufferRange (" + std::to_string(range) + " bytes)");
+  }
   const std::uint64_t cache_bytes =
       (std::uint64_t(config.cache_slots) * slot_voxels * vb + 3) & ~3ull;
-  const std::array<std::pair<std::uint64_t, const char*>, 7> sizes = {{
-      {cache_bytes, "brick cache"},
+  const std::array<std::pair<std::uint64_t, const char*>, 6> sizes = {{
       {std::uint64_t(config.page_entries) * 4, "page table"},
       {(std::uint64_t(config.page_tables) + 1) * 4, "page table offsets"},
       {config.node_words * 4, "octree"},
@@ -337,7 +372,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
       {std::uint64_t(node_cap) * 8, "node request set"},
       {(std::uint64_t(config.cache_slots) + 31) / 32 * 4, "used-slot bitmap"},
   }};
-  std::uint64_t total = 0;
+  std::uint64_t total = cache_bytes;
   for (const auto& [bytes, what] : sizes) {
     if (bytes > m.ctx->props.limits.maxStorageBufferRange) {
       throw Error(ErrorCode::out_of_memory, std::string("vulkan: ") + what + " of " +
@@ -355,7 +390,13 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.slot_voxels = std::size_t(slot_voxels);
   m.brick_capacity = brick_cap;
   m.node_capacity = node_cap;
-  const Binding order[] = {b_cache,          b_pages,         b_page_offsets, b_nodes,
+  m.slots_per_chunk = slots_per_chunk;
+  for (std::uint32_t c = 0; c < kCacheChunks; ++c) {
+    const std::uint32_t first = std::min(config.cache_slots, c * slots_per_chunk);
+    const std::uint32_t n = std::min(config.cache_slots - first, slots_per_chunk);
+    m.ensure(cache_binding(c), (std::uint64_t(n) * brick_bytes + 3) & ~3ull, "brick cache");
+  }
+  const Binding order[] = {b_pages,          b_page_offsets,  b_nodes,
                            b_brick_requests, b_node_requests, b_used};
   for (std::size_t i = 0; i < sizes.size(); ++i)
     m.ensure(order[i], sizes[i].first, sizes[i].second);
@@ -369,7 +410,6 @@ void VulkanBackend::update(const FrameUpdate& u) {
   Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("update", "backend is not configured");
   const std::size_t brick_bytes = m.slot_voxels * m.voxel_bytes;
-  auto* cache = static_cast<std::byte*>(m.buf[b_cache].mapped);
   auto* pages = static_cast<std::uint32_t*>(m.buf[b_pages].mapped);
   auto* offsets = static_cast<std::uint32_t*>(m.buf[b_page_offsets].mapped);
   auto* nodes = static_cast<std::uint32_t*>(m.buf[b_nodes].mapped);
@@ -387,7 +427,7 @@ void VulkanBackend::update(const FrameUpdate& u) {
       throw invalid_parameter("update", "brick of " + std::to_string(b.voxels.size()) +
                                             " bytes, expected " + std::to_string(brick_bytes));
     }
-    std::memcpy(cache + std::size_t(b.cache_slot) * brick_bytes, b.voxels.data(), brick_bytes);
+    std::memcpy(m.slot_address(b.cache_slot), b.voxels.data(), brick_bytes);
   }
   if (u.pages_full) {
     if (u.all_pages.size() != page_count) {
@@ -473,7 +513,8 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
                           nullptr);
   const PushConstants pc{
       m.brick_capacity, log2_pow2(m.brick_capacity), std::min(kMaxProbes, m.brick_capacity),
-      m.node_capacity,  log2_pow2(m.node_capacity),  std::min(kMaxProbes, m.node_capacity)};
+      m.node_capacity,  log2_pow2(m.node_capacity),  std::min(kMaxProbes, m.node_capacity),
+      m.slots_per_chunk};
   vkCmdPushConstants(m.cmd, m.pipeline_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(pc), &pc);
   vkCmdDispatch(m.cmd, (frame.width + kWorkgroup - 1) / kWorkgroup,
                 (frame.height + kWorkgroup - 1) / kWorkgroup, 1);
@@ -554,6 +595,10 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+void VulkanBackend::debug_limit_cache_buffer(std::uint64_t bytes) noexcept {
+  impl_->cache_buffer_limit = bytes;
+}
+
 std::vector<std::byte> VulkanBackend::debug_read(DeviceArray array) const {
   const Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("array", "backend is not configured");
@@ -578,7 +623,14 @@ std::vector<std::byte> VulkanBackend::debug_read(DeviceArray array) const {
       break;
   }
   std::vector<std::byte> out(bytes);
-  if (bytes) std::memcpy(out.data(), m.buf[b].mapped, bytes);
+  if (array == DeviceArray::cache) {
+    const std::size_t brick_bytes = m.slot_voxels * m.voxel_bytes;
+    for (std::uint32_t s = 0; s < m.config.cache_slots; ++s) {
+      std::memcpy(out.data() + std::size_t(s) * brick_bytes, m.slot_address(s), brick_bytes);
+    }
+  } else if (bytes) {
+    std::memcpy(out.data(), m.buf[b].mapped, bytes);
+  }
   return out;
 }
 

@@ -133,6 +133,18 @@ TEST(VulkanOracle, PartialBricksAndU16AndF32Types) {
     compare_all_modes(*gpu, rs, scene, std::string(spec) + " checkerboard",
                       RequestStrategy::greedy);
   }
+  // The same data with the cache split over several buffers of 5 bricks (10^3 voxels) each.
+  for (const char* spec : {"procedural:noisefloor:40x24x32", "procedural:ramp:20x36x28"}) {
+    ProceduralSource src(spec, small_bricks());
+    const bool ramp = std::string(spec).find("ramp") != std::string::npos;
+    const Scene scene = shipped_scene(ramp ? "ramp" : "noisefloor");
+    ResidentOptions ro;
+    ro.level_resident = [](std::uint32_t level) { return level >= 1; };
+    ResidentScene rs(src, scene_channels(scene), ro);
+    gpu->debug_limit_cache_buffer(5u * 1000u * (ramp ? 4u : 1u));
+    compare_all_modes(*gpu, rs, scene, std::string(spec) + " split cache", RequestStrategy::global);
+    gpu->debug_limit_cache_buffer(0);
+  }
   expect_no_validation_messages(*gpu);
 }
 

@@ -18,7 +18,9 @@ std::vector<T> as_words(const std::vector<std::byte>& bytes) {
   return w;
 }
 
-void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t seed) {
+void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t seed,
+                          std::uint64_t chunk_limit) {
+  gpu.debug_limit_cache_buffer(chunk_limit);
   BackendConfig cfg;
   cfg.voxel_type = type;
   cfg.padded_brick = {5, 3, 7};  // odd sizes: u8/u16 bricks straddle 32-bit words
@@ -103,9 +105,13 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
 TEST(VulkanState, RandomDeltasAndUploadsMatchTheHostArrays) {
   auto gpu = make_validated_vulkan();
   if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
-  check_random_updates(*gpu, VoxelType::u8, 1);
-  check_random_updates(*gpu, VoxelType::u16, 2);
-  check_random_updates(*gpu, VoxelType::f32, 3);
+  check_random_updates(*gpu, VoxelType::u8, 1, 0);
+  check_random_updates(*gpu, VoxelType::u16, 2, 0);
+  check_random_updates(*gpu, VoxelType::f32, 3, 0);
+  // 13 slots split over 7 cache buffers of two bricks each.
+  check_random_updates(*gpu, VoxelType::u8, 4, 2 * 105 + 3);
+  check_random_updates(*gpu, VoxelType::u16, 5, 2 * 210 + 3);
+  check_random_updates(*gpu, VoxelType::f32, 6, 2 * 420 + 3);
   expect_no_validation_messages(*gpu);
 }
 
@@ -135,6 +141,11 @@ TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
   EXPECT_RESOCT_ERROR(gpu->render(t, r), ErrorCode::invalid_argument, "tables");
   cfg.padded_brick = {0, 4, 4};
   EXPECT_RESOCT_ERROR(gpu->configure(cfg), ErrorCode::invalid_argument, "config");
+  // 20 slots of one 64-byte brick per buffer need more than 8 buffers.
+  cfg.padded_brick = {4, 4, 4};
+  cfg.cache_slots = 20;
+  gpu->debug_limit_cache_buffer(64);
+  EXPECT_RESOCT_ERROR(gpu->configure(cfg), ErrorCode::out_of_memory, "buffers");
   expect_no_validation_messages(*gpu);
 }
 

@@ -2,7 +2,8 @@
 /// \file
 /// The Vulkan compute backend: the single-source traversal kernel compiled to SPIR-V
 /// (src/backend_vulkan/shaders/render.comp), one invocation per pixel. Device state lives in
-/// storage buffers; the voxel cache is a buffer of voxels of the configured type filtered in the
+/// storage buffers; the voxel cache is up to 8 buffers of whole bricks (one buffer may not exceed
+/// maxStorageBufferRange) holding voxels of the configured type filtered in the
 /// shader exactly like the CPU backend, so the CPU backend is its test oracle.
 
 #include <cstdint>
@@ -62,6 +63,11 @@ class VulkanBackend : public Backend {
   /// Test support: copies a device array back to the host (cache as bytes, others as uint32
   /// words packed little-endian into bytes). Waits for the device.
   std::vector<std::byte> debug_read(DeviceArray array) const;
+
+  /// Test support: caps the bytes of each cache buffer (default and upper bound:
+  /// maxStorageBufferRange) from the next configure() on, so that tests exercise a cache split
+  /// over several buffers. 0 restores the default.
+  void debug_limit_cache_buffer(std::uint64_t bytes) noexcept;
 
   struct Impl;
 

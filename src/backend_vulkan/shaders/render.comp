@@ -26,6 +26,7 @@ layout(push_constant) uniform Push {
   uint node_capacity;
   uint node_log2_capacity;
   uint node_max_probes;
+  uint slots_per_chunk;  // cache slots per cache buffer
 }
 pc;
 
@@ -37,7 +38,17 @@ layout(std430, binding = 4) readonly buffer Nodes { uint nodes[]; };
 layout(std430, binding = 5) readonly buffer Pages { uint pages[]; };
 layout(std430, binding = 6) readonly buffer PageOffsets { uint page_offsets[]; };
 layout(std430, binding = 7) readonly buffer TfLuts { vec4 tf_entries[]; };
-layout(std430, binding = 8) readonly buffer Cache { uint cache_words[]; };
+// The cache is split into up to 8 buffers of whole bricks (chunk c holds slots
+// [c * slots_per_chunk, (c + 1) * slots_per_chunk)), because one storage buffer may not exceed
+// maxStorageBufferRange (128 MiB on some devices). Chunk 0 is binding 8, chunks 1-7 bindings 14-20.
+layout(std430, binding = 8) readonly buffer Cache0 { uint cache0[]; };
+layout(std430, binding = 14) readonly buffer Cache1 { uint cache1[]; };
+layout(std430, binding = 15) readonly buffer Cache2 { uint cache2[]; };
+layout(std430, binding = 16) readonly buffer Cache3 { uint cache3[]; };
+layout(std430, binding = 17) readonly buffer Cache4 { uint cache4[]; };
+layout(std430, binding = 18) readonly buffer Cache5 { uint cache5[]; };
+layout(std430, binding = 19) readonly buffer Cache6 { uint cache6[]; };
+layout(std430, binding = 20) readonly buffer Cache7 { uint cache7[]; };
 // Request sets: keys in [0, capacity), hit counts in [capacity, 2 * capacity).
 layout(std430, binding = 9) buffer BrickRequests { uint brick_req[]; };
 layout(std430, binding = 10) buffer NodeRequests { uint node_req[]; };
@@ -74,10 +85,24 @@ ResoctDepthInfo resoct_read_depth(uint d) { return depths[d]; }
 vec4 resoct_read_tf(uint slot, uint index) { return tf_entries[slot * 1024u + index]; }
 float resoct_read_level_size_log2(uint level) { return levels[level].size_log2; }
 
-float load_voxel(uint i) {
-  if (VOXEL_TYPE == 0u) return float((cache_words[i >> 2u] >> ((i & 3u) * 8u)) & 0xFFu);
-  if (VOXEL_TYPE == 1u) return float((cache_words[i >> 1u] >> ((i & 1u) * 16u)) & 0xFFFFu);
-  return uintBitsToFloat(cache_words[i]);
+uint cache_word(uint chunk, uint w) {
+  switch (chunk) {
+    case 0u: return cache0[w];
+    case 1u: return cache1[w];
+    case 2u: return cache2[w];
+    case 3u: return cache3[w];
+    case 4u: return cache4[w];
+    case 5u: return cache5[w];
+    case 6u: return cache6[w];
+    default: return cache7[w];
+  }
+}
+
+// Voxel i (counted from the start of its chunk).
+float load_voxel(uint chunk, uint i) {
+  if (VOXEL_TYPE == 0u) return float((cache_word(chunk, i >> 2u) >> ((i & 3u) * 8u)) & 0xFFu);
+  if (VOXEL_TYPE == 1u) return float((cache_word(chunk, i >> 1u) >> ((i & 1u) * 16u)) & 0xFFFFu);
+  return uintBitsToFloat(cache_word(chunk, i));
 }
 
 // As the CPU backend: clamp to [0, hi], NaN to 0 so that no NaN becomes an index.
@@ -96,12 +121,13 @@ float resoct_sample_cache(uint cache_slot, vec3 pos) {
   precise float fx = cx - float(x0);
   precise float fy = cy - float(y0);
   precise float fz = cz - float(z0);
-  uint i = cache_slot * uint(PADDED_X * PADDED_Y * PADDED_Z) +
+  uint chunk = cache_slot / pc.slots_per_chunk;
+  uint i = (cache_slot - chunk * pc.slots_per_chunk) * uint(PADDED_X * PADDED_Y * PADDED_Z) +
            (uint(z0) * uint(PADDED_Y) + uint(y0)) * uint(PADDED_X) + uint(x0);
-  float v000 = load_voxel(i), v100 = load_voxel(i + dx);
-  float v010 = load_voxel(i + dy), v110 = load_voxel(i + dy + dx);
-  float v001 = load_voxel(i + dz), v101 = load_voxel(i + dz + dx);
-  float v011 = load_voxel(i + dz + dy), v111 = load_voxel(i + dz + dy + dx);
+  float v000 = load_voxel(chunk, i), v100 = load_voxel(chunk, i + dx);
+  float v010 = load_voxel(chunk, i + dy), v110 = load_voxel(chunk, i + dy + dx);
+  float v001 = load_voxel(chunk, i + dz), v101 = load_voxel(chunk, i + dz + dx);
+  float v011 = load_voxel(chunk, i + dz + dy), v111 = load_voxel(chunk, i + dz + dy + dx);
   precise float c00 = v000 + fx * (v100 - v000);
   precise float c10 = v010 + fx * (v110 - v010);
   precise float c01 = v001 + fx * (v101 - v001);
