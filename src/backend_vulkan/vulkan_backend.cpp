@@ -81,7 +81,7 @@ struct VulkanBackend::Impl {
   VkQueryPool queries = VK_NULL_HANDLE;
   std::array<Buffer, binding_count> buf{};
   bool descriptors_dirty = true;
-  std::array<std::uint32_t, 6> pipeline_key{};
+  std::array<std::uint32_t, 7> pipeline_key{};
 
   BackendConfig config{};
   bool configured = false;
@@ -89,6 +89,7 @@ struct VulkanBackend::Impl {
   std::size_t slot_voxels = 0;
   std::uint32_t brick_capacity = 1, node_capacity = 1;
   std::uint32_t slots_per_chunk = 1;     // cache slots per cache buffer
+  std::uint32_t chunks = 1;              // cache buffers in use
   std::uint64_t cache_buffer_limit = 0;  // test override of maxStorageBufferRange (0 = none)
 
   /// Where cache slot `slot` starts: its chunk's mapping plus the byte offset in it.
@@ -216,14 +217,15 @@ void VulkanBackend::Impl::write_descriptors() {
 
 void VulkanBackend::Impl::build_pipeline() {
   // Specialization: voxel type and padded brick size are constants of the cache addressing.
-  const std::array<std::uint32_t, 6> values = {std::uint32_t(config.voxel_type),
+  const std::array<std::uint32_t, 7> values = {std::uint32_t(config.voxel_type),
                                                config.padded_brick.x,
                                                config.padded_brick.y,
                                                config.padded_brick.z,
+                                               chunks,
                                                kWorkgroup,
                                                kWorkgroup};
-  const std::array<VkSpecializationMapEntry, 6> entries = {
-      {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {10, 16, 4}, {11, 20, 4}}};
+  const std::array<VkSpecializationMapEntry, 7> entries = {
+      {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}, {10, 20, 4}, {11, 24, 4}}};
   VkSpecializationInfo si{};
   si.mapEntryCount = std::uint32_t(entries.size());
   si.pMapEntries = entries.data();
@@ -391,6 +393,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.brick_capacity = brick_cap;
   m.node_capacity = node_cap;
   m.slots_per_chunk = slots_per_chunk;
+  m.chunks = std::max(chunks, 1u);
   for (std::uint32_t c = 0; c < kCacheChunks; ++c) {
     const std::uint32_t first = std::min(config.cache_slots, c * slots_per_chunk);
     const std::uint32_t n = std::min(config.cache_slots - first, slots_per_chunk);
@@ -402,7 +405,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");
   m.ensure(b_frame, sizeof(kernel::ResoctFrame), "frame constants");
-  m.build_pipeline();
+  // The pipeline is built by the first render(): compiling the kernel takes seconds on CPU
+  // devices, and a configuration that is only updated never needs it.
   m.configured = true;
 }
 
@@ -474,6 +478,7 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
            "transfer functions");
   m.ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   m.write_descriptors();
+  m.build_pipeline();
   std::memcpy(m.buf[b_frame].mapped, &frame, sizeof(frame));
   std::memcpy(m.buf[b_slots].mapped, tables.slots.data(),
               tables.slots.size() * sizeof(tables.slots[0]));

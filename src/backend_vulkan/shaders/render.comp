@@ -15,6 +15,8 @@ layout(constant_id = 0) const uint VOXEL_TYPE = 0u;
 layout(constant_id = 1) const int PADDED_X = 34;
 layout(constant_id = 2) const int PADDED_Y = 34;
 layout(constant_id = 3) const int PADDED_Z = 34;
+// Cache buffers in use (1..8); 1 removes the per-sample buffer choice.
+layout(constant_id = 4) const uint CACHE_CHUNKS = 1u;
 
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
@@ -85,25 +87,21 @@ ResoctDepthInfo resoct_read_depth(uint d) { return depths[d]; }
 vec4 resoct_read_tf(uint slot, uint index) { return tf_entries[slot * 1024u + index]; }
 float resoct_read_level_size_log2(uint level) { return levels[level].size_log2; }
 
-uint cache_word(uint chunk, uint w) {
-  switch (chunk) {
-    case 0u: return cache0[w];
-    case 1u: return cache1[w];
-    case 2u: return cache2[w];
-    case 3u: return cache3[w];
-    case 4u: return cache4[w];
-    case 5u: return cache5[w];
-    case 6u: return cache6[w];
-    default: return cache7[w];
-  }
-}
-
-// Voxel i (counted from the start of its chunk).
-float load_voxel(uint chunk, uint i) {
-  if (VOXEL_TYPE == 0u) return float((cache_word(chunk, i >> 2u) >> ((i & 3u) * 8u)) & 0xFFu);
-  if (VOXEL_TYPE == 1u) return float((cache_word(chunk, i >> 1u) >> ((i & 1u) * 16u)) & 0xFFFFu);
-  return uintBitsToFloat(cache_word(chunk, i));
-}
+// Voxel j (counted from the start of its chunk) of cache buffer `buf`, decoded per voxel type.
+#define RESOCT_VOXEL(buf, j)                                                        \
+  (VOXEL_TYPE == 0u   ? float((buf[(j) >> 2u] >> (((j)&3u) * 8u)) & 0xFFu)          \
+   : VOXEL_TYPE == 1u ? float((buf[(j) >> 1u] >> (((j)&1u) * 16u)) & 0xFFFFu)       \
+                      : uintBitsToFloat(buf[(j)]))
+// The 2x2x2 cell from one buffer: the chunk is chosen once per sample, not per voxel.
+#define RESOCT_LOAD_CELL(buf)                                                       \
+  v000 = RESOCT_VOXEL(buf, i);                                                      \
+  v100 = RESOCT_VOXEL(buf, i + dx);                                                 \
+  v010 = RESOCT_VOXEL(buf, i + dy);                                                 \
+  v110 = RESOCT_VOXEL(buf, i + dy + dx);                                            \
+  v001 = RESOCT_VOXEL(buf, i + dz);                                                 \
+  v101 = RESOCT_VOXEL(buf, i + dz + dx);                                            \
+  v011 = RESOCT_VOXEL(buf, i + dz + dy);                                            \
+  v111 = RESOCT_VOXEL(buf, i + dz + dy + dx)
 
 // As the CPU backend: clamp to [0, hi], NaN to 0 so that no NaN becomes an index.
 float clamp_coord(float v, float hi) { return v > 0.0 ? (v < hi ? v : hi) : 0.0; }
@@ -124,10 +122,21 @@ float resoct_sample_cache(uint cache_slot, vec3 pos) {
   uint chunk = cache_slot / pc.slots_per_chunk;
   uint i = (cache_slot - chunk * pc.slots_per_chunk) * uint(PADDED_X * PADDED_Y * PADDED_Z) +
            (uint(z0) * uint(PADDED_Y) + uint(y0)) * uint(PADDED_X) + uint(x0);
-  float v000 = load_voxel(chunk, i), v100 = load_voxel(chunk, i + dx);
-  float v010 = load_voxel(chunk, i + dy), v110 = load_voxel(chunk, i + dy + dx);
-  float v001 = load_voxel(chunk, i + dz), v101 = load_voxel(chunk, i + dz + dx);
-  float v011 = load_voxel(chunk, i + dz + dy), v111 = load_voxel(chunk, i + dz + dy + dx);
+  float v000, v100, v010, v110, v001, v101, v011, v111;
+  if (CACHE_CHUNKS == 1u) {
+    RESOCT_LOAD_CELL(cache0);
+  } else {
+    switch (chunk) {
+      case 0u: RESOCT_LOAD_CELL(cache0); break;
+      case 1u: RESOCT_LOAD_CELL(cache1); break;
+      case 2u: RESOCT_LOAD_CELL(cache2); break;
+      case 3u: RESOCT_LOAD_CELL(cache3); break;
+      case 4u: RESOCT_LOAD_CELL(cache4); break;
+      case 5u: RESOCT_LOAD_CELL(cache5); break;
+      case 6u: RESOCT_LOAD_CELL(cache6); break;
+      default: RESOCT_LOAD_CELL(cache7); break;
+    }
+  }
   precise float c00 = v000 + fx * (v100 - v000);
   precise float c10 = v010 + fx * (v110 - v010);
   precise float c01 = v001 + fx * (v101 - v001);
