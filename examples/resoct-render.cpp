@@ -20,6 +20,10 @@
 #include "resoct/scene.hpp"
 #include "support/tool_main.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
+#ifdef RESOCT_RENDER_WITH_VULKAN
+#include "resoct/vulkan/devices.hpp"
+#include "resoct/vulkan/vulkan_backend.hpp"
+#endif
 
 namespace {
 
@@ -29,6 +33,9 @@ struct Args {
   std::string volume;
   std::string scene;
   std::string backend = "cpu";
+  std::string device;
+  bool validation = false;
+  bool list_devices = false;
   std::string mode = "residency";
   std::uint32_t width = 0;
   std::uint32_t height = 0;
@@ -115,10 +122,34 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   w.commit();
 }
 
+#ifdef RESOCT_RENDER_WITH_VULKAN
+int print_devices() {
+  const auto devices = resoct::vk::list_devices();
+  if (devices.empty()) std::printf("no Vulkan device\n");
+  for (const auto& d : devices) {
+    std::printf("%u: %s (%s, Vulkan %s, %.0f MiB device-local%s)\n", d.index, d.name.c_str(),
+                d.type.c_str(), resoct::vk::api_version_string(d.api_version).c_str(),
+                double(d.device_local_bytes) / 1048576.0,
+                d.has_compute_queue ? "" : ", no compute");
+  }
+  return 0;
+}
+#endif
+
 int run(const Args& a) {
+#ifdef RESOCT_RENDER_WITH_VULKAN
+  if (a.list_devices) return print_devices();
+  resoct::vk::register_backend();
+#else
+  if (a.list_devices) throw invalid_parameter("list-devices", "this build has no Vulkan backend");
+#endif
+  if (a.volume.empty()) throw invalid_parameter("volume", "--volume is required");
+  if (a.scene.empty()) throw invalid_parameter("scene", "--scene is required");
   resoct::cpu::register_backend();
   RendererOptions o;
   o.backend = a.backend;
+  o.backend_options.device = a.device;
+  o.backend_options.validation = a.validation;
   o.mode = parse_render_mode(a.mode);
   o.strategy = parse_strategy(a.strategy);
   if (a.cache_mb == 0 || a.cache_mb > (std::uint64_t(1) << 24)) {
@@ -191,9 +222,13 @@ int run(const Args& a) {
 int main(int argc, char** argv) {
   CLI::App app{"Render a volume with the residency octree renderer"};
   Args a;
-  app.add_option("--volume", a.volume, std::string(kSourceSpecForms))->required();
-  app.add_option("--scene", a.scene, "scene JSON (docs/scene.md)")->required();
-  app.add_option("--backend", a.backend, "registered backend name")->capture_default_str();
+  app.add_option("--volume", a.volume, std::string(kSourceSpecForms) + " (required)");
+  app.add_option("--scene", a.scene, "scene JSON (docs/scene.md) (required)");
+  app.add_option("--backend", a.backend, "cpu | vulkan (when built) | registered backend name")
+      ->capture_default_str();
+  app.add_option("--device", a.device, "Vulkan device index or name substring");
+  app.add_flag("--validation", a.validation, "Vulkan: enable the validation layers");
+  app.add_flag("--list-devices", a.list_devices, "list Vulkan devices and exit");
   app.add_option("--mode", a.mode, "residency | pagetable | octree")->capture_default_str();
   app.add_option("--width", a.width, "image width (overrides the scene viewport)");
   app.add_option("--height", a.height, "image height (overrides the scene viewport)");

@@ -1,0 +1,185 @@
+// Device state of the Vulkan backend: after many random updates (full arrays, page and octree
+// deltas, brick uploads) the device arrays read back equal a host mirror; bad input and unknown
+// devices fail with the documented errors.
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "vulkan_test_util.hpp"
+#include "support/expect_error.hpp"
+
+namespace resoct::test {
+namespace {
+
+template <class T>
+std::vector<T> as_words(const std::vector<std::byte>& bytes) {
+  std::vector<T> w(bytes.size() / sizeof(T));
+  std::memcpy(w.data(), bytes.data(), w.size() * sizeof(T));
+  return w;
+}
+
+void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t seed,
+                          std::uint64_t chunk_limit) {
+  gpu.debug_limit_cache_buffer(chunk_limit);
+  BackendConfig cfg;
+  cfg.voxel_type = type;
+  cfg.padded_brick = {5, 3, 7};  // odd sizes: u8/u16 bricks straddle 32-bit words
+  cfg.cache_slots = 13;
+  cfg.page_entries = 777;
+  cfg.page_tables = 6;
+  cfg.node_words = 1001;
+  cfg.brick_request_capacity = 100;
+  cfg.node_request_capacity = 50;
+  gpu.configure(cfg);
+
+  const std::size_t brick_bytes = 5u * 3u * 7u * voxel_size(type);
+  std::vector<std::byte> cache(cfg.cache_slots * brick_bytes, std::byte{0});
+  std::vector<std::uint32_t> pages(cfg.page_entries, 0), offsets(cfg.page_tables + 1u, 0);
+  std::vector<std::uint32_t> nodes(cfg.node_words, 0);
+  // configure() leaves every array zero.
+  EXPECT_EQ(gpu.debug_read(vk::DeviceArray::cache), cache);
+  EXPECT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pages);
+  EXPECT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)), nodes);
+
+  std::mt19937 rng(seed);
+  auto pick = [&rng](std::size_t n) { return std::uint32_t(rng() % n); };
+  for (int round = 0; round < 60; ++round) {
+    FrameUpdate u;
+    std::vector<std::vector<std::byte>> brick_data;
+    std::vector<BrickUpload> uploads;
+    std::vector<PageDelta> pd;
+    std::vector<OctreeWordDelta> nd;
+    std::vector<std::uint32_t> all_pages, all_offsets, all_nodes;
+    const int nb = int(rng() % 4);
+    for (int i = 0; i < nb; ++i) {
+      std::vector<std::byte> v(brick_bytes);
+      for (auto& b : v) b = std::byte(rng() & 0xFFu);
+      brick_data.push_back(std::move(v));
+    }
+    for (const auto& v : brick_data) {
+      const std::uint32_t slot = pick(cfg.cache_slots);
+      uploads.push_back({slot, v});
+      std::memcpy(cache.data() + slot * brick_bytes, v.data(), brick_bytes);
+    }
+    if (round % 17 == 0) {
+      all_pages.resize(pages.size());
+      for (auto& p : all_pages) p = std::uint32_t(rng());
+      all_offsets.resize(offsets.size());
+      for (auto& o : all_offsets) o = pick(pages.size() + 1);
+      pages = all_pages;
+      offsets = all_offsets;
+      u.pages_full = true;
+      u.all_pages = all_pages;
+      u.page_table_offsets = all_offsets;
+    }
+    if (round % 23 == 5) {
+      all_nodes.resize(nodes.size());
+      for (auto& w : all_nodes) w = std::uint32_t(rng());
+      nodes = all_nodes;
+      u.nodes_full = true;
+      u.all_nodes = all_nodes;
+    }
+    for (int i = int(rng() % 40); i > 0; --i) {
+      PageDelta d{pick(pages.size()), std::uint32_t(rng())};
+      pd.push_back(d);
+      pages[d.index] = d.value;  // later deltas of the same index win
+    }
+    for (int i = int(rng() % 40); i > 0; --i) {
+      OctreeWordDelta d{pick(nodes.size()), std::uint32_t(rng())};
+      nd.push_back(d);
+      nodes[d.index] = d.value;
+    }
+    u.bricks = uploads;
+    u.page_deltas = pd;
+    u.node_deltas = nd;
+    gpu.update(u);
+    if (round % 10 == 9) {
+      ASSERT_EQ(gpu.debug_read(vk::DeviceArray::cache), cache) << "round " << round;
+      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pages);
+      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::page_offsets)), offsets);
+      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)), nodes);
+    }
+  }
+}
+
+TEST(VulkanState, RandomDeltasAndUploadsMatchTheHostArrays) {
+  auto gpu = make_validated_vulkan();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  check_random_updates(*gpu, VoxelType::u8, 1, 0);
+  check_random_updates(*gpu, VoxelType::u16, 2, 0);
+  check_random_updates(*gpu, VoxelType::f32, 3, 0);
+  // 13 slots split over 7 cache buffers of two bricks each.
+  check_random_updates(*gpu, VoxelType::u8, 4, 2 * 105 + 3);
+  check_random_updates(*gpu, VoxelType::u16, 5, 2 * 210 + 3);
+  check_random_updates(*gpu, VoxelType::f32, 6, 2 * 420 + 3);
+  expect_no_validation_messages(*gpu);
+}
+
+TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
+  auto gpu = make_validated_vulkan();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  FrameUpdate none;
+  EXPECT_RESOCT_ERROR(gpu->update(none), ErrorCode::invalid_argument, "update");
+  BackendConfig cfg;
+  cfg.padded_brick = {4, 4, 4};
+  cfg.cache_slots = 2;
+  cfg.page_entries = 8;
+  cfg.page_tables = 1;
+  cfg.node_words = 8;
+  gpu->configure(cfg);
+  std::vector<std::byte> wrong(10);
+  const BrickUpload up{0, wrong};
+  FrameUpdate u;
+  u.bricks = {&up, 1};
+  EXPECT_RESOCT_ERROR(gpu->update(u), ErrorCode::invalid_argument, "update");
+  const PageDelta far{8, 1};
+  FrameUpdate v;
+  v.page_deltas = {&far, 1};
+  EXPECT_RESOCT_ERROR(gpu->update(v), ErrorCode::invalid_argument, "page delta");
+  FrameTables t;
+  FrameResult r;
+  EXPECT_RESOCT_ERROR(gpu->render(t, r), ErrorCode::invalid_argument, "tables");
+  cfg.padded_brick = {0, 4, 4};
+  EXPECT_RESOCT_ERROR(gpu->configure(cfg), ErrorCode::invalid_argument, "config");
+  // 20 slots of one 64-byte brick per buffer need more than 8 buffers.
+  cfg.padded_brick = {4, 4, 4};
+  cfg.cache_slots = 20;
+  gpu->debug_limit_cache_buffer(64);
+  EXPECT_RESOCT_ERROR(gpu->configure(cfg), ErrorCode::out_of_memory, "buffers");
+  expect_no_validation_messages(*gpu);
+}
+
+TEST(VulkanState, UnknownDeviceNameIsADeviceError) {
+  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  BackendOptions o;
+  o.device = "no-such-gpu-xyz";
+  EXPECT_RESOCT_ERROR(vk::VulkanBackend{o}, ErrorCode::device, "device");
+  o.device = "999";
+  EXPECT_RESOCT_ERROR(vk::VulkanBackend{o}, ErrorCode::device, "device");
+}
+
+TEST(VulkanState, RegisteredFactorySelectsByNameAndIndex) {
+  const auto devices = vk::list_devices();
+  if (devices.empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  vk::register_backend();
+  BackendOptions o;
+  o.validation = true;
+  o.device = "0";
+  auto b = create_backend("vulkan", o);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->name(), "vulkan");
+  auto* vb = dynamic_cast<vk::VulkanBackend*>(b.get());
+  ASSERT_NE(vb, nullptr);
+  EXPECT_EQ(vb->device_name(), devices[0].name);
+  // A lower-case substring of the name selects the same device.
+  std::string sub = devices[0].name.substr(0, 4);
+  for (char& ch : sub) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  o.device = sub;
+  vk::VulkanBackend by_name(o);
+  EXPECT_NE(by_name.device_name().find(devices[0].name.substr(0, 4)), std::string::npos);
+  expect_no_validation_messages(*vb);
+  expect_no_validation_messages(by_name);
+}
+
+}  // namespace
+}  // namespace resoct::test
