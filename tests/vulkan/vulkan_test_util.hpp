@@ -78,13 +78,14 @@ inline std::pair<std::size_t, std::uint64_t> request_difference(const std::vecto
 
 /// Compares a Vulkan frame with the CPU frame of the same state and tables.
 ///
-/// Measured on lavapipe: colours agree to ~1e-5; requests, used slots and integer statistics
-/// agree exactly in most scenes, but a ray whose sample lands within float rounding of a brick
-/// or node border can differ by one sample (lavapipe's LLVM backend contracts a * b + c into
-/// fused multiply-adds and evaluates divisions and transcendentals differently from the host's
-/// libm, and the shared kernel headers cannot mark every expression `precise`). So integer
-/// outputs may differ by a handful of events per frame: at most max(8, 0.2%) per statistic, a
-/// few request keys and hits, and one used slot. `diff` accumulates the largest differences.
+/// Measured on lavapipe: colours agree to ~1e-5, and the request KEYS and the used cache slots
+/// (the working set) are identical, so those are asserted exactly. Sample/node/iteration counts
+/// and request hit counts differ by a handful of events per frame (at most 62 of ~10^4 in the
+/// worst scene). The cause is not yet found: forbidding fused multiply-adds in the shader and
+/// disabling early termination changed nothing; a ray that clips the volume box differently
+/// (division or log2/exp2 rounding) is the leading suspect. Until it is found, those counters
+/// are allowed max(8, 0.2%) and hits max(8, 0.2% of inserts). `diff` accumulates the largest
+/// differences.
 inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
                               const std::string& what, OracleDiff& diff) {
   auto near = [&](std::uint64_t a, std::uint64_t b, const char* name) {
@@ -108,7 +109,7 @@ inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
     const auto [keys, hits] = request_difference(a, b);
     diff.request_keys = std::max(diff.request_keys, keys);
     diff.request_hits = std::max(diff.request_hits, hits);
-    EXPECT_LE(keys, std::max<std::size_t>(2, a.size() / 100)) << what << " request keys";
+    EXPECT_EQ(keys, 0u) << what << " request keys";
     EXPECT_LE(hits, std::max<std::uint64_t>(8, cpu.stats.request_inserts / 500))
         << what << " request hits";
     if (a.empty()) {
@@ -120,7 +121,7 @@ inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
                                 gpu.used_cache_slots.begin(), gpu.used_cache_slots.end(),
                                 std::back_inserter(only));
   diff.used_slots = std::max(diff.used_slots, only.size());
-  EXPECT_LE(only.size(), 1u) << what << " used cache slots";
+  EXPECT_EQ(only.size(), 0u) << what << " used cache slots";
   // Distances are summed as per-ray fixed point (2^-20 box units) on the device.
   const double rays = double(cpu.stats.rays);
   EXPECT_NEAR(cpu.stats.distance_marched, gpu.stats.distance_marched,
