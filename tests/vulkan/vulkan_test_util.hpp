@@ -78,21 +78,17 @@ inline std::pair<std::size_t, std::uint64_t> request_difference(const std::vecto
 
 /// Compares a Vulkan frame with the CPU frame of the same state and tables.
 ///
-/// Measured on lavapipe: colours agree to ~1e-5, and the request KEYS and the used cache slots
-/// (the working set) are identical, so those are asserted exactly. Sample/node/iteration counts
-/// and request hit counts differ by a handful of events per frame (at most 62 of ~10^4 in the
-/// worst scene). The cause is not yet found: forbidding fused multiply-adds in the shader and
-/// disabling early termination changed nothing; a ray that clips the volume box differently
-/// (division or log2/exp2 rounding) is the leading suspect. Until it is found, those counters
-/// are allowed max(8, 0.2%) and hits max(8, 0.2% of inserts). `diff` accumulates the largest
-/// differences.
+/// Integer outputs must be identical (DESIGN.md §7): statistics, request keys and hit counts,
+/// and the used cache slots (the working set). Colours may differ by float rounding (measured on
+/// lavapipe: ~1e-5), asserted within 2/255. The march ends a sliver before the exit
+/// (RESOCT_SEGMENT_EPS), so the last ulp of the device's division cannot add a sample.
+/// `diff` accumulates the largest differences for the report line.
 inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
                               const std::string& what, OracleDiff& diff) {
   auto near = [&](std::uint64_t a, std::uint64_t b, const char* name) {
     const std::uint64_t d = a > b ? a - b : b - a;
     diff.stat_abs = std::max(diff.stat_abs, d);
-    EXPECT_LE(d, std::max<std::uint64_t>(8, a / 500))
-        << what << " " << name << " cpu " << a << " vulkan " << b;
+    EXPECT_EQ(d, 0u) << what << " " << name << " cpu " << a << " vulkan " << b;
   };
   EXPECT_EQ(cpu.stats.rays, gpu.stats.rays) << what;
   near(cpu.stats.samples, gpu.stats.samples, "samples");
@@ -110,8 +106,7 @@ inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
     diff.request_keys = std::max(diff.request_keys, keys);
     diff.request_hits = std::max(diff.request_hits, hits);
     EXPECT_EQ(keys, 0u) << what << " request keys";
-    EXPECT_LE(hits, std::max<std::uint64_t>(8, cpu.stats.request_inserts / 500))
-        << what << " request hits";
+    EXPECT_EQ(hits, 0u) << what << " request hits";
     if (a.empty()) {
       EXPECT_TRUE(b.empty()) << what;
     }

@@ -60,6 +60,9 @@ RESOCT_FN float resoct_advance_t(float t, float dt) {
 /// Length of the segment that starts at t: the step, shortened at the exit so that segments tile
 /// [t_enter, t_exit) and the last sample's opacity is corrected for its true length. Sample at
 /// the segment's midpoint; 0 once t >= t_exit.
+/// Fraction of a step below which the rest of a ray inside the volume is not sampled.
+RESOCT_CONST(float, RESOCT_SEGMENT_EPS, 1.0e-4f);
+
 RESOCT_FN float resoct_segment_length(float t, float dt, float t_exit) {
   return max(min(dt, t_exit - t), 0.0f);
 }

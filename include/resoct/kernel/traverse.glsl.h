@@ -206,7 +206,10 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   uint cached_homog = 0u;
   uint cached_skip_depth = RESOCT_NONE_U;
 
-  while (t < t_exit) {
+  // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
+  // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs
+  // between host and device division and would make the backends' sample counts disagree.
+  while (t_exit - t > RESOCT_SEGMENT_EPS * dt) {
     if (stats.iterations >= f.max_iterations) {
       stats.cap_hits = 1u;
       break;
