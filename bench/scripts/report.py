@@ -76,7 +76,9 @@ def table1(ctx, rows, out):
 def decoupling(ctx, rows, out, plots):
     out.append("### Decoupling study (`bench_decoupling`, paper 000 Fig. 10)\n")
     out.append(context_line(ctx) + "\n")
-    out.append("ms/frame, slab 512×512×40 (standard preset), bricks 32³.\n")
+    size = {"smoke": "64×64×40", "large": "1024×1024×40"}.get(ctx.get("resoct_preset"),
+                                                            "512×512×40")
+    out.append(f"ms/frame, slab {size}, bricks 32³.\n")
     out.append("| leaf | channels | pagetable | octree | residency | res/pt | res/oct |")
     out.append("|---|---|---|---|---|---|---|")
     table = {}
