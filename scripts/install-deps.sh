@@ -10,6 +10,7 @@ PACKAGES=(
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libpng-dev libcli11-dev libcurl4-openssl-dev libblosc-dev libtiff-dev
+  python3-matplotlib
 )
 
 missing=()

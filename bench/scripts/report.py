@@ -1,0 +1,266 @@
+#!/usr/bin/env python3
+"""Turns the JSON of bench_table1, bench_decoupling and bench_accuracy into Markdown tables,
+Pareto-front CSVs and (when matplotlib is installed) PNG plots.
+
+  python3 bench/scripts/report.py [--results bench/results] [--readme bench/README.md]
+
+Reads <results>/{table1,decoupling,accuracy}.json (whichever exist), writes
+<results>/results.md, <results>/pareto_<dataset>.csv and <results>/*.png, and replaces the text
+between the "results:begin" / "results:end" markers of the README with results.md.
+Python 3 standard library; plots need python3-matplotlib (Debian), skipped with a note otherwise.
+"""
+import argparse
+import csv
+import json
+import os
+import re
+import sys
+
+MODES = {0: "residency", 1: "pagetable", 2: "octree"}
+TABLE1_NAMES = ["tubes", "noisefloor", "turbulence", "mandelbulb", "cells"]
+LEAF_NAMES = ["32³", "16³", "8³", "8×8×4"]
+ACC_NAMES = ["tubes", "turbulence", "cells"]
+BEGIN = "<!-- results:begin -->"
+END = "<!-- results:end -->"
+
+
+def load(path):
+    if not os.path.exists(path):
+        return None
+    with open(path, encoding="utf-8") as f:
+        data = json.load(f)
+    rows = []
+    for b in data.get("benchmarks", []):
+        if b.get("run_type", "iteration") != "iteration":
+            continue
+        args = dict((k, int(v)) for k, v in re.findall(r"(\w+):(\d+)", b["name"]))
+        rows.append((args, b))
+    return data.get("context", {}), rows
+
+
+def fmt(x, digits=3):
+    if x is None:
+        return "–"
+    if abs(x) >= 100:
+        return f"{x:.0f}"
+    return f"{x:.{digits}g}"
+
+
+def context_line(ctx):
+    return (f"{ctx.get('date', '?')}, preset `{ctx.get('resoct_preset', '?')}`, "
+            f"{ctx.get('num_cpus', '?')} CPUs @ {ctx.get('mhz_per_cpu', '?')} MHz, "
+            f"load average {', '.join(f'{x:.1f}' for x in ctx.get('load_avg', []))}")
+
+
+def table1(ctx, rows, out):
+    out.append("### Table 1 analogue (`bench_table1`)\n")
+    out.append(context_line(ctx) + "\n")
+    out.append("| dataset | ch | mode | ms/frame | working set MiB | samples/ray | nodes/ray | "
+               "bricks touched | res/pt ms | res/oct ms | res/pt WS | res/oct WS |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    ratios = {}
+    for args, b in rows:
+        d, c, m = args["dataset"], args["channels"], args["mode"]
+        r = [b.get(k) for k in ("res_over_pt", "res_over_oct", "ws_res_over_pt",
+                                "ws_res_over_oct")]
+        if m == 0:
+            ratios[(TABLE1_NAMES[d], c)] = r
+        out.append(f"| {TABLE1_NAMES[d]} | {c} | {MODES[m]} | {fmt(b['ms_frame'])} | "
+                   f"{fmt(b['working_set_MiB'])} | {fmt(b['samples_per_ray'])} | "
+                   f"{fmt(b['nodes_per_ray'])} | {fmt(b['bricks_touched'])} | "
+                   + " | ".join(fmt(x) if m == 0 else "" for x in r) + " |")
+    out.append("")
+    return ratios
+
+
+def decoupling(ctx, rows, out, plots):
+    out.append("### Decoupling study (`bench_decoupling`, paper 000 Fig. 10)\n")
+    out.append(context_line(ctx) + "\n")
+    size = {"smoke": "64×64×40", "large": "1024×1024×40"}.get(ctx.get("resoct_preset"),
+                                                            "512×512×40")
+    out.append(f"ms/frame, slab {size}, bricks 32³.\n")
+    out.append("| leaf | channels | pagetable | octree | residency | res/pt | res/oct |")
+    out.append("|---|---|---|---|---|---|---|")
+    table = {}
+    for args, b in rows:
+        table.setdefault((args["leaf"], args["channels"]), {})[args["mode"]] = b["ms_frame"]
+    for (leaf, ch), ms in sorted(table.items()):
+        res, pt, oc = ms.get(0), ms.get(1), ms.get(2)
+        out.append(f"| {LEAF_NAMES[leaf]} | {ch} | {fmt(pt)} | {fmt(oc)} | {fmt(res)} | "
+                   f"{fmt(res / pt if res and pt else None)} | "
+                   f"{fmt(res / oc if res and oc else None)} |")
+    out.append("")
+    if plots is not None:
+        plt = plots
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        for leaf in sorted({k[0] for k in table}):
+            for mode, style in ((0, "-"), (1, ":"), (2, "--")):
+                pts = sorted((ch, ms[mode]) for (lf, ch), ms in table.items()
+                             if lf == leaf and mode in ms)
+                if mode != 0 and leaf != 0:
+                    continue  # pagetable and octree barely depend on the leaf: draw one each
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o",
+                        label=f"{MODES[mode]}" + (f" leaf {LEAF_NAMES[leaf]}" if mode == 0
+                                                  else f" (leaf {LEAF_NAMES[leaf]})"))
+        ax.set_xlabel("visible channels")
+        ax.set_ylabel("ms/frame")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(RESULTS, "decoupling.png"), dpi=110)
+        plt.close(fig)
+        out.append("![decoupling](results/decoupling.png)\n")
+
+
+def pareto(points):
+    """Points (ms, rmse, label) not beaten by a faster-or-equal point with lower-or-equal error."""
+    front = []
+    best = float("inf")
+    for p in sorted(points, key=lambda p: (p[0], p[1])):
+        if p[1] < best:
+            front.append(p)
+            best = p[1]
+    return front
+
+
+def accuracy(ctx, rows, out, plots):
+    out.append("### Accuracy against the dense reference (`bench_accuracy`)\n")
+    out.append(context_line(ctx) + "\n")
+    out.append("RMSE / max error of RGB in [0, 1]; residency mode; one fixed view.\n")
+    verdicts = {}
+    by_set = {}
+    for args, b in rows:
+        by_set.setdefault(args["dataset"], []).append(b)
+    for d, bs in sorted(by_set.items()):
+        name = ACC_NAMES[d]
+        out.append(f"#### {name}\n")
+        out.append("| setting | step | LOD px | ms/frame | RMSE | PSNR dB | max err |")
+        out.append("|---|---|---|---|---|---|---|")
+        for b in bs:
+            out.append(f"| {b.get('label', '')} | {fmt(b['step_scale'])} | {fmt(b['lod_px'])} | "
+                       f"{fmt(b['ms_frame'])} | {b['rmse']:.5f} | {fmt(b['psnr_db'])} | "
+                       f"{b['max_err']:.4f} |")
+        # Settings one would choose: everything but the uncorrected-opacity demonstration.
+        cands = [(b["ms_frame"], b["rmse"], b.get("label", ""), b["step_scale"], b["lod_px"])
+                 for b in bs if "off" not in b.get("label", "")]
+        front = pareto(cands)
+        with open(os.path.join(RESULTS, f"pareto_{name}.csv"), "w", newline="",
+                  encoding="utf-8") as f:
+            w = csv.writer(f)
+            w.writerow(["ms_frame", "rmse", "setting", "step_scale", "lod_px"])
+            for p in front:
+                w.writerow([f"{p[0]:.4f}", f"{p[1]:.6f}", p[2], p[3], p[4]])
+        finest = [b for b in bs if b.get("label", "").endswith("/grid")
+                  and b["step_scale"] == 0.25 and b["lod_px"] == 0.5]
+        if finest:
+            base = finest[0]["ms_frame"]
+            v = {}
+            for limit in (1, 4):
+                ok = [p for p in cands if p[1] <= limit / 255.0]
+                v[limit] = (base / min(p[0] for p in ok)) if ok else None
+            verdicts[name] = (base, finest[0]["rmse"], v)
+            out.append(f"\nFinest setting (step 0.25, LOD 0.5 px): {fmt(base)} ms, RMSE "
+                       f"{finest[0]['rmse']:.5f}. Fastest with RMSE ≤ 1/255: "
+                       f"{fmt(v[1])}× faster; with RMSE ≤ 4/255: {fmt(v[4])}× faster. "
+                       f"Pareto front: `results/pareto_{name}.csv`.\n")
+        if plots is not None:
+            plt = plots
+            fig, ax = plt.subplots(figsize=(6, 4))
+            ax.scatter([p[0] for p in cands], [p[1] for p in cands], s=12, label="settings")
+            ax.plot([p[0] for p in front], [p[1] for p in front], "-o", color="C3",
+                    label="Pareto front")
+            for lim in (1, 4):
+                ax.axhline(lim / 255.0, ls=":", color="gray")
+            ax.set_xlabel("ms/frame")
+            ax.set_ylabel("RMSE (RGB)")
+            ax.set_yscale("log")
+            ax.set_title(name)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            fig.savefig(os.path.join(RESULTS, f"pareto_{name}.png"), dpi=110)
+            plt.close(fig)
+            out.append(f"![pareto {name}](results/pareto_{name}.png)\n")
+    return verdicts
+
+
+def targets(ratios, verdicts, out):
+    out.append("### Issue targets\n")
+    out.append("| target | measured | verdict |")
+    out.append("|---|---|---|")
+
+    def row(what, value, limit, higher_is_better=False):
+        if value is None:
+            out.append(f"| {what} | – | not measured |")
+            return
+        ok = value >= limit if higher_is_better else value <= limit
+        miss = "" if ok else (f" (missed by {limit / value:.2f}×)" if higher_is_better
+                              else f" (missed by {value / limit:.2f}×)")
+        out.append(f"| {what} | {value:.3f} | {'met' if ok else 'missed' + miss} |")
+
+    for ds in ("tubes", "noisefloor"):
+        r = ratios.get((ds, 4))
+        if r:
+            row(f"{ds} 4 ch: residency/pagetable ms ≤ 0.45", r[0], 0.45)
+            row(f"{ds} 4 ch: residency/octree ms ≤ 0.35", r[1], 0.35)
+            row(f"{ds} 4 ch: working set residency/pagetable ≤ 0.3", r[2], 0.3)
+            row(f"{ds} 4 ch: working set residency/octree ≤ 0.6", r[3], 0.6)
+    r = ratios.get(("cells", 16))
+    if r:
+        row("slab 16 ch: residency/pagetable ms ≤ 0.75", r[0], 0.75)
+        row("slab 16 ch: residency/octree ms ≤ 0.25", r[1], 0.25)
+    for c in (1, 4):
+        r = ratios.get(("turbulence", c))
+        if r:
+            row(f"dense (turbulence) {c} ch: residency/pagetable ms ≤ 1.1", r[0], 1.1)
+    for name, (_, _, v) in sorted(verdicts.items()):
+        row(f"{name}: speed-up at RMSE ≤ 1/255 ≥ 2×", v[1], 2.0, True)
+        row(f"{name}: speed-up at RMSE ≤ 4/255 ≥ 5×", v[4], 5.0, True)
+    out.append("")
+
+
+def main():
+    global RESULTS
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap.add_argument("--results", default=os.path.join(here, "results"))
+    ap.add_argument("--readme", default=os.path.join(here, "README.md"))
+    a = ap.parse_args()
+    RESULTS = a.results
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        plots = plt
+    except ImportError:
+        plots = None
+        print("report.py: matplotlib missing (apt-get install python3-matplotlib): no PNGs",
+              file=sys.stderr)
+    out = []
+    ratios, verdicts = {}, {}
+    t = load(os.path.join(RESULTS, "table1.json"))
+    if t:
+        ratios = table1(*t, out)
+    t = load(os.path.join(RESULTS, "decoupling.json"))
+    if t:
+        decoupling(*t, out, plots)
+    t = load(os.path.join(RESULTS, "accuracy.json"))
+    if t:
+        verdicts = accuracy(*t, out, plots)
+    targets(ratios, verdicts, out)
+    text = "\n".join(out)
+    with open(os.path.join(RESULTS, "results.md"), "w", encoding="utf-8") as f:
+        f.write(text.replace("](results/", "]("))
+    if os.path.exists(a.readme):
+        with open(a.readme, encoding="utf-8") as f:
+            readme = f.read()
+        if BEGIN in readme and END in readme:
+            head, rest = readme.split(BEGIN, 1)
+            _, tail = rest.split(END, 1)
+            with open(a.readme, "w", encoding="utf-8") as f:
+                f.write(head + BEGIN + "\n" + text + "\n" + END + tail)
+    print(text)
+
+
+RESULTS = "."
+if __name__ == "__main__":
+    main()
