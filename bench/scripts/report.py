@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Turns the JSON of bench_table1, bench_decoupling and bench_accuracy into Markdown tables,
 Pareto-front CSVs and (when matplotlib is installed) PNG plots.
 
