@@ -83,10 +83,5 @@ BENCHMARK(BM_Decoupling)
 }  // namespace
 
 int main(int argc, char** argv) {
-  init_preset(argc, argv);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return resoct::bench::run_benchmarks(argc, argv);
 }

@@ -1,5 +1,7 @@
 #include "support/bench_rig.hpp"
 
+#include <benchmark/benchmark.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -151,6 +153,15 @@ FrameAverages run_frames(benchmark::State& state, Rig& rig,
   state.counters["brick_accesses_per_ray"] = a.brick_accesses_per_ray;
   state.SetItemsProcessed(std::int64_t(total.rays));
   return a;
+}
+
+int run_benchmarks(int argc, char** argv) {
+  init_preset(argc, argv);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
 }
 
 }  // namespace resoct::bench

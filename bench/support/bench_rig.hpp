@@ -24,6 +24,8 @@ enum class Preset { smoke, standard, large };
 /// Reads RESOCT_BENCH_SMOKE / RESOCT_BENCH_LARGE and removes --smoke / --large from argv (before
 /// benchmark::Initialize sees them). Call once from main.
 Preset init_preset(int& argc, char** argv);
+/// The main() of every rig benchmark: reads the preset flags, then runs Google Benchmark.
+int run_benchmarks(int argc, char** argv);
 /// The preset chosen by init_preset.
 Preset preset();
 const char* to_string(Preset p);

@@ -102,6 +102,11 @@ struct FrameResult {
   BackendStats stats;
 };
 
+/// Checks that per-frame tables are consistent with themselves and with the configured sizes, so
+/// that a backend never indexes outside its arrays. Throws Error(invalid_argument) naming
+/// "tables". Every backend calls it at the start of render().
+void check_frame_tables(const FrameTables& tables, const BackendConfig& config);
+
 /// A rendering device. Not thread-safe: one Renderer drives it from one thread.
 class Backend {
  public:

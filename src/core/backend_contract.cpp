@@ -1,0 +1,43 @@
+#include <string>
+
+#include "resoct/backend.hpp"
+#include "resoct/error.hpp"
+#include "resoct/transfer_function.hpp"
+
+namespace resoct {
+
+void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
+  const kernel::ResoctFrame& f = t.frame;
+  auto fail = [](const std::string& why) { throw invalid_parameter("tables", why); };
+  if (f.width == 0 || f.height == 0) fail("empty image");
+  if (t.slots.size() != f.slot_count || f.slot_count > kernel::RESOCT_MAX_SLOTS) {
+    fail("slot table size differs from slot_count");
+  }
+  if (t.levels.size() != f.level_count || f.level_count == 0 || f.level_count > 32) {
+    fail("level table size differs from level_count");
+  }
+  if (t.depths.size() != f.depth_count || f.depth_count == 0) {
+    fail("depth table size differs from depth_count");
+  }
+  if (std::size_t(f.page_slot_count) * f.level_count != config.page_tables) {
+    fail("page_slot_count * level_count differs from the configured page tables");
+  }
+  if (t.tf_luts.size() != std::size_t(f.page_slot_count) * kTfLutSize) {
+    fail("tf_luts size differs from page_slot_count * RESOCT_TF_LUT_SIZE");
+  }
+  if (std::size_t(t.depths.back().first_node) * f.node_slot_count * 4u >= config.node_words + 1u &&
+      config.node_words != 0) {
+    fail("octree is smaller than the depth table");
+  }
+  if (glm::uvec3(f.padded_x, f.padded_y, f.padded_z) != config.padded_brick) {
+    fail("padded brick size differs from the configuration");
+  }
+  for (const auto& s : t.slots) {
+    if (s.slot >= f.page_slot_count || s.finest_level > s.coarsest_level ||
+        s.coarsest_level >= f.level_count) {
+      fail("slot entry out of range");
+    }
+  }
+}
+
+}  // namespace resoct
