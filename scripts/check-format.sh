@@ -2,7 +2,7 @@
 # Fails when a tracked C++/GLSL source differs from .clang-format's output.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mapfile -t files < <(git ls-files '*.hpp' '*.cpp' '*.h' 2>/dev/null || true)
+mapfile -t files < <(git ls-files '*.hpp' '*.cpp' '*.h' '*.comp' 2>/dev/null || true)
 [ ${#files[@]} -gt 0 ] || exit 0
 bad=0
 for f in "${files[@]}"; do

@@ -8,19 +8,27 @@
 
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 0) buffer Pages { uint pages[]; };
-layout(std430, binding = 1) buffer OutWords { uint words[]; };
-layout(std430, binding = 2) buffer OutValues { float values[]; };
+layout(std430, binding = 0) buffer Pages {
+  uint pages[];
+};
+layout(std430, binding = 1) buffer OutWords {
+  uint words[];
+};
+layout(std430, binding = 2) buffer OutValues {
+  float values[];
+};
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint e = pages[i];
   uint acc = resoct_page_state(e) + resoct_page_payload(e) + resoct_page_cache_slot(e);
   if (resoct_page_is_mapped(e) || resoct_page_is_constant(e)) acc += 1u;
-  acc += resoct_page_encode_mapped(i) ^ resoct_page_encode_homogeneous(i & 0xFFFFu) ^ RESOCT_PAGE_EMPTY_WORD;
+  acc += resoct_page_encode_mapped(i) ^ resoct_page_encode_homogeneous(i & 0xFFFFu) ^
+         RESOCT_PAGE_EMPTY_WORD;
   acc += resoct_page_local_index(uvec3(i, 1u, 2u), uvec3(64u, 4u, 4u));
   uint key = resoct_request_key_encode(resoct_request_table_id(1u, 2u, 8u), i);
-  acc += resoct_request_key_table(key) + resoct_request_key_local(key) + resoct_request_key_hash(key, 12u);
+  acc += resoct_request_key_table(key) + resoct_request_key_local(key) +
+         resoct_request_key_hash(key, 12u);
   if (key == RESOCT_REQUEST_KEY_NONE) acc = 0u;
   words[i] = acc;
   values[i] = resoct_page_homogeneous_value(e);

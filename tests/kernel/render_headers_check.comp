@@ -1,12 +1,19 @@
 #version 450
-// Compile check: the render kernel headers are valid GLSL 4.50 (tests/core/test_render_kernel_glsl.cpp
-// runs glslangValidator on this file). Every function is called so that it is type-checked.
+// Compile check: the render kernel headers are valid GLSL 4.50
+// (tests/core/test_render_kernel_glsl.cpp runs glslangValidator on this file). Every function is
+// called so that it is type-checked.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 1) in;
 
-layout(std430, binding = 0) readonly buffer TfLuts { vec4 tf_entries[]; };
-layout(std430, binding = 1) readonly buffer LevelSizes { float level_size_log2[]; };
-layout(std430, binding = 2) buffer Out { vec4 results[]; };
+layout(std430, binding = 0) readonly buffer TfLuts {
+  vec4 tf_entries[];
+};
+layout(std430, binding = 1) readonly buffer LevelSizes {
+  float level_size_log2[];
+};
+layout(std430, binding = 2) buffer Out {
+  vec4 results[];
+};
 
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];

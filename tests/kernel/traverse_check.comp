@@ -7,29 +7,76 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "resoct/kernel/frame.glsl.h"
 
-layout(std430, binding = 0) readonly buffer Frame { ResoctFrame frame; };
-layout(std430, binding = 1) readonly buffer Slots { ResoctSlotInfo slots[]; };
-layout(std430, binding = 2) readonly buffer Levels { ResoctLevelInfo levels[]; };
-layout(std430, binding = 3) readonly buffer Depths { ResoctDepthInfo depths[]; };
-layout(std430, binding = 4) readonly buffer Nodes { uint nodes[]; };
-layout(std430, binding = 5) readonly buffer Pages { uint pages[]; };
-layout(std430, binding = 6) readonly buffer PageOffsets { uint page_offsets[]; };
-layout(std430, binding = 7) readonly buffer TfLuts { vec4 tf_entries[]; };
-layout(std430, binding = 8) readonly buffer Cache { float cache_voxels[]; };
-layout(std430, binding = 9) buffer Requests { uint request_count; uint request_keys[]; };
-layout(std430, binding = 10) buffer NodeRequests { uint node_request_count; uint node_keys[]; };
-layout(std430, binding = 11) buffer Used { uint used_bits[]; };
-layout(std430, binding = 12) buffer Out { vec4 pixels[]; };
-layout(std430, binding = 13) buffer Stats { uint stat_samples; uint stat_caps; };
+layout(std430, binding = 0) readonly buffer Frame {
+  ResoctFrame frame;
+};
+layout(std430, binding = 1) readonly buffer Slots {
+  ResoctSlotInfo slots[];
+};
+layout(std430, binding = 2) readonly buffer Levels {
+  ResoctLevelInfo levels[];
+};
+layout(std430, binding = 3) readonly buffer Depths {
+  ResoctDepthInfo depths[];
+};
+layout(std430, binding = 4) readonly buffer Nodes {
+  uint nodes[];
+};
+layout(std430, binding = 5) readonly buffer Pages {
+  uint pages[];
+};
+layout(std430, binding = 6) readonly buffer PageOffsets {
+  uint page_offsets[];
+};
+layout(std430, binding = 7) readonly buffer TfLuts {
+  vec4 tf_entries[];
+};
+layout(std430, binding = 8) readonly buffer Cache {
+  float cache_voxels[];
+};
+layout(std430, binding = 9) buffer Requests {
+  uint request_count;
+  uint request_keys[];
+};
+layout(std430, binding = 10) buffer NodeRequests {
+  uint node_request_count;
+  uint node_keys[];
+};
+layout(std430, binding = 11) buffer Used {
+  uint used_bits[];
+};
+layout(std430, binding = 12) buffer Out {
+  vec4 pixels[];
+};
+layout(std430, binding = 13) buffer Stats {
+  uint stat_samples;
+  uint stat_caps;
+};
 
-uint resoct_read_node(uint index) { return nodes[index]; }
-uint resoct_read_page(uint index) { return pages[index]; }
-uint resoct_read_page_table_offset(uint table) { return page_offsets[table]; }
-ResoctSlotInfo resoct_read_slot(uint i) { return slots[i]; }
-ResoctLevelInfo resoct_read_level(uint l) { return levels[l]; }
-ResoctDepthInfo resoct_read_depth(uint d) { return depths[d]; }
-vec4 resoct_read_tf(uint slot, uint index) { return tf_entries[slot * 1024u + index]; }
-float resoct_read_level_size_log2(uint level) { return levels[level].size_log2; }
+uint resoct_read_node(uint index) {
+  return nodes[index];
+}
+uint resoct_read_page(uint index) {
+  return pages[index];
+}
+uint resoct_read_page_table_offset(uint table) {
+  return page_offsets[table];
+}
+ResoctSlotInfo resoct_read_slot(uint i) {
+  return slots[i];
+}
+ResoctLevelInfo resoct_read_level(uint l) {
+  return levels[l];
+}
+ResoctDepthInfo resoct_read_depth(uint d) {
+  return depths[d];
+}
+vec4 resoct_read_tf(uint slot, uint index) {
+  return tf_entries[slot * 1024u + index];
+}
+float resoct_read_level_size_log2(uint level) {
+  return levels[level].size_log2;
+}
 
 float cache_voxel(uint cache_slot, ivec3 v) {
   uint px = frame.padded_x;

@@ -32,32 +32,74 @@ layout(push_constant) uniform Push {
 }
 pc;
 
-layout(std430, binding = 0) readonly buffer FrameBuf { ResoctFrame frame; };
-layout(std430, binding = 1) readonly buffer Slots { ResoctSlotInfo slots[]; };
-layout(std430, binding = 2) readonly buffer Levels { ResoctLevelInfo levels[]; };
-layout(std430, binding = 3) readonly buffer Depths { ResoctDepthInfo depths[]; };
-layout(std430, binding = 4) readonly buffer Nodes { uint nodes[]; };
-layout(std430, binding = 5) readonly buffer Pages { uint pages[]; };
-layout(std430, binding = 6) readonly buffer PageOffsets { uint page_offsets[]; };
-layout(std430, binding = 7) readonly buffer TfLuts { vec4 tf_entries[]; };
+layout(std430, binding = 0) readonly buffer FrameBuf {
+  ResoctFrame frame;
+};
+layout(std430, binding = 1) readonly buffer Slots {
+  ResoctSlotInfo slots[];
+};
+layout(std430, binding = 2) readonly buffer Levels {
+  ResoctLevelInfo levels[];
+};
+layout(std430, binding = 3) readonly buffer Depths {
+  ResoctDepthInfo depths[];
+};
+layout(std430, binding = 4) readonly buffer Nodes {
+  uint nodes[];
+};
+layout(std430, binding = 5) readonly buffer Pages {
+  uint pages[];
+};
+layout(std430, binding = 6) readonly buffer PageOffsets {
+  uint page_offsets[];
+};
+layout(std430, binding = 7) readonly buffer TfLuts {
+  vec4 tf_entries[];
+};
 // The cache is split into up to 8 buffers of whole bricks (chunk c holds slots
 // [c * slots_per_chunk, (c + 1) * slots_per_chunk)), because one storage buffer may not exceed
 // maxStorageBufferRange (128 MiB on some devices). Chunk 0 is binding 8, chunks 1-7 bindings 14-20.
-layout(std430, binding = 8) readonly buffer Cache0 { uint cache0[]; };
-layout(std430, binding = 14) readonly buffer Cache1 { uint cache1[]; };
-layout(std430, binding = 15) readonly buffer Cache2 { uint cache2[]; };
-layout(std430, binding = 16) readonly buffer Cache3 { uint cache3[]; };
-layout(std430, binding = 17) readonly buffer Cache4 { uint cache4[]; };
-layout(std430, binding = 18) readonly buffer Cache5 { uint cache5[]; };
-layout(std430, binding = 19) readonly buffer Cache6 { uint cache6[]; };
-layout(std430, binding = 20) readonly buffer Cache7 { uint cache7[]; };
+layout(std430, binding = 8) readonly buffer Cache0 {
+  uint cache0[];
+};
+layout(std430, binding = 14) readonly buffer Cache1 {
+  uint cache1[];
+};
+layout(std430, binding = 15) readonly buffer Cache2 {
+  uint cache2[];
+};
+layout(std430, binding = 16) readonly buffer Cache3 {
+  uint cache3[];
+};
+layout(std430, binding = 17) readonly buffer Cache4 {
+  uint cache4[];
+};
+layout(std430, binding = 18) readonly buffer Cache5 {
+  uint cache5[];
+};
+layout(std430, binding = 19) readonly buffer Cache6 {
+  uint cache6[];
+};
+layout(std430, binding = 20) readonly buffer Cache7 {
+  uint cache7[];
+};
 // Request sets: keys in [0, capacity), hit counts in [capacity, 2 * capacity).
-layout(std430, binding = 9) buffer BrickRequests { uint brick_req[]; };
-layout(std430, binding = 10) buffer NodeRequests { uint node_req[]; };
-layout(std430, binding = 11) buffer Used { uint used_bits[]; };
-layout(std430, binding = 12) writeonly buffer Out { vec4 pixels[]; };
+layout(std430, binding = 9) buffer BrickRequests {
+  uint brick_req[];
+};
+layout(std430, binding = 10) buffer NodeRequests {
+  uint node_req[];
+};
+layout(std430, binding = 11) buffer Used {
+  uint used_bits[];
+};
+layout(std430, binding = 12) writeonly buffer Out {
+  vec4 pixels[];
+};
 // 64-bit counters as (low, high) uint pairs; see STAT_* below.
-layout(std430, binding = 13) buffer Stats { uint stats[]; };
+layout(std430, binding = 13) buffer Stats {
+  uint stats[];
+};
 
 const uint STAT_SAMPLES = 0u;
 const uint STAT_NODES = 2u;
@@ -78,33 +120,51 @@ void stat_add(uint index, uint v) {
   if (old + v < old) atomicAdd(stats[index + 1u], 1u);
 }
 
-uint resoct_read_node(uint index) { return nodes[index]; }
-uint resoct_read_page(uint index) { return pages[index]; }
-uint resoct_read_page_table_offset(uint table) { return page_offsets[table]; }
-ResoctSlotInfo resoct_read_slot(uint i) { return slots[i]; }
-ResoctLevelInfo resoct_read_level(uint l) { return levels[l]; }
-ResoctDepthInfo resoct_read_depth(uint d) { return depths[d]; }
-vec4 resoct_read_tf(uint slot, uint index) { return tf_entries[slot * 1024u + index]; }
-float resoct_read_level_size_log2(uint level) { return levels[level].size_log2; }
+uint resoct_read_node(uint index) {
+  return nodes[index];
+}
+uint resoct_read_page(uint index) {
+  return pages[index];
+}
+uint resoct_read_page_table_offset(uint table) {
+  return page_offsets[table];
+}
+ResoctSlotInfo resoct_read_slot(uint i) {
+  return slots[i];
+}
+ResoctLevelInfo resoct_read_level(uint l) {
+  return levels[l];
+}
+ResoctDepthInfo resoct_read_depth(uint d) {
+  return depths[d];
+}
+vec4 resoct_read_tf(uint slot, uint index) {
+  return tf_entries[slot * 1024u + index];
+}
+float resoct_read_level_size_log2(uint level) {
+  return levels[level].size_log2;
+}
 
 // Voxel j (counted from the start of its chunk) of cache buffer `buf`, decoded per voxel type.
-#define RESOCT_VOXEL(buf, j)                                                        \
-  (VOXEL_TYPE == 0u   ? float((buf[(j) >> 2u] >> (((j)&3u) * 8u)) & 0xFFu)          \
-   : VOXEL_TYPE == 1u ? float((buf[(j) >> 1u] >> (((j)&1u) * 16u)) & 0xFFFFu)       \
+#define RESOCT_VOXEL(buf, j)                                                  \
+  (VOXEL_TYPE == 0u   ? float((buf[(j) >> 2u] >> (((j)&3u) * 8u)) & 0xFFu)    \
+   : VOXEL_TYPE == 1u ? float((buf[(j) >> 1u] >> (((j)&1u) * 16u)) & 0xFFFFu) \
                       : uintBitsToFloat(buf[(j)]))
 // The 2x2x2 cell from one buffer: the chunk is chosen once per sample, not per voxel.
-#define RESOCT_LOAD_CELL(buf)                                                       \
-  v000 = RESOCT_VOXEL(buf, i);                                                      \
-  v100 = RESOCT_VOXEL(buf, i + dx);                                                 \
-  v010 = RESOCT_VOXEL(buf, i + dy);                                                 \
-  v110 = RESOCT_VOXEL(buf, i + dy + dx);                                            \
-  v001 = RESOCT_VOXEL(buf, i + dz);                                                 \
-  v101 = RESOCT_VOXEL(buf, i + dz + dx);                                            \
-  v011 = RESOCT_VOXEL(buf, i + dz + dy);                                            \
+#define RESOCT_LOAD_CELL(buf)            \
+  v000 = RESOCT_VOXEL(buf, i);           \
+  v100 = RESOCT_VOXEL(buf, i + dx);      \
+  v010 = RESOCT_VOXEL(buf, i + dy);      \
+  v110 = RESOCT_VOXEL(buf, i + dy + dx); \
+  v001 = RESOCT_VOXEL(buf, i + dz);      \
+  v101 = RESOCT_VOXEL(buf, i + dz + dx); \
+  v011 = RESOCT_VOXEL(buf, i + dz + dy); \
   v111 = RESOCT_VOXEL(buf, i + dz + dy + dx)
 
 // As the CPU backend: clamp to [0, hi], NaN to 0 so that no NaN becomes an index.
-float clamp_coord(float v, float hi) { return v > 0.0 ? (v < hi ? v : hi) : 0.0; }
+float clamp_coord(float v, float hi) {
+  return v > 0.0 ? (v < hi ? v : hi) : 0.0;
+}
 
 float resoct_sample_cache(uint cache_slot, vec3 pos) {
   precise float cx = clamp_coord(pos.x - 0.5, float(PADDED_X - 1));
@@ -179,8 +239,12 @@ void node_insert(uint key) {
   stat_add(STAT_NODE_DROPPED, 1u);
 }
 
-void resoct_report_request(uint device_key) { brick_insert(device_key); }
-void resoct_report_node_request(uint node) { node_insert(node); }
+void resoct_report_request(uint device_key) {
+  brick_insert(device_key);
+}
+void resoct_report_node_request(uint node) {
+  node_insert(node);
+}
 void resoct_mark_used(uint cache_slot) {
   uint bit = 1u << (cache_slot & 31u);
   // Read first: almost every call finds the bit set already.
