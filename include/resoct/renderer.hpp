@@ -118,7 +118,7 @@ class Renderer {
   std::uint64_t frame_index() const noexcept { return frame_; }
 
  private:
-  FrameTables frame_tables(const Scene& scene) const;
+  const FrameTables& frame_tables(const Scene& scene);
   void assign_channels(const Scene& scene);
   void apply_loaded(FrameStats& stats);
   bool apply_one(const LoadedBrick& b, FrameStats& stats);
@@ -152,6 +152,7 @@ class Renderer {
   std::vector<std::byte> scratch_;  // keeps the voxels of this frame's uploads alive
   std::vector<std::shared_ptr<const HostBrick>> upload_data_;
   std::vector<BrickUpload> uploads_;
+  FrameTables tables_;
   FrameResult result_;
 };
 

@@ -334,14 +334,16 @@ void Renderer::report_failures(FrameReport& report) {
   }
 }
 
-FrameTables Renderer::frame_tables(const Scene& scene) const {
+const FrameTables& Renderer::frame_tables(const Scene& scene) {
   FrameOptions fo;
   fo.mode = options_.mode;
   fo.frame_index = std::uint32_t(frame_);
   fo.request_strategy = options_.strategy;
   fo.start_depth = options_.start_depth;
   fo.max_iterations = options_.max_iterations;
-  return build_frame_tables(scene, hierarchy_, layout_, channels_, fo);
+  // Rebuilt every frame (camera and TFs change) into the same vectors: no per-frame allocation.
+  build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
+  return tables_;
 }
 
 FrameReport Renderer::render_frame(const Scene& scene) {
