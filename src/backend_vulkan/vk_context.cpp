@@ -119,6 +119,15 @@ void fill_properties(Context& c) {
                 "device: queue family " + std::to_string(c.family) + " has no compute queue");
   }
   c.timestamp_bits = c.props.limits.timestampPeriod > 0.0f ? q[c.family].timestampValidBits : 0u;
+  if (c.props.apiVersion >= VK_API_VERSION_1_2) {
+    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    p2.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(c.physical, &p2);
+    // llvmpipe's guard against endless loops (Mesa gallivm LP_MAX_TGSI_LOOP_ITERATIONS): one
+    // counter per invocation batch, decremented at every loop back-edge of the shader.
+    if (driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE) c.loop_limit = 65535;
+  }
   vkGetDeviceQueue(c.device, c.family, 0, &c.queue);
 }
 

@@ -50,6 +50,10 @@ std::string VulkanBackend::device_name() const {
   return impl_->ctx->props.deviceName;
 }
 
+std::uint32_t VulkanBackend::loop_iteration_limit() const noexcept {
+  return impl_->ctx->loop_limit;
+}
+
 std::uint64_t VulkanBackend::validation_messages() const noexcept {
   return impl_->ctx->messages.load(std::memory_order_relaxed);
 }

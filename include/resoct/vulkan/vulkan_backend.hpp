@@ -63,6 +63,12 @@ class VulkanBackend : public Backend {
 
   /// Name of the physical device in use.
   std::string device_name() const;
+  /// Loop back-edges one shader invocation may take before the driver ends all its loops, or 0
+  /// when the driver has no such limit. Mesa's lavapipe has one (65535, counted over every loop
+  /// of the kernel: roughly 2000 march iterations of a simple ray); a ray it cuts short is
+  /// counted in BackendStats::cap_hits, like a ray stopped by max_iterations, never silently
+  /// rendered short.
+  std::uint32_t loop_iteration_limit() const noexcept;
   /// Validation-layer warnings and errors recorded so far (0 when validation is off).
   std::uint64_t validation_messages() const noexcept;
   /// The recorded validation messages (the first 64).
