@@ -67,8 +67,6 @@ struct PushConstants {
 };
 
 constexpr std::uint32_t kWorkgroup = 8;
-// kernel/tf.glsl.h RESOCT_TF_LUT_SIZE (that header needs the accessors, which live in the shader).
-constexpr std::size_t kTfLutSize = 1024;
 constexpr std::uint32_t kMaxProbes = 16;  // RequestSet's default, which the CPU backend uses
 constexpr std::uint32_t kStatWords = 20;
 constexpr double kDistanceScale = 1048576.0;  // shaders/render.comp DISTANCE_SCALE
