@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -65,6 +66,8 @@ struct Totals {
   std::uint64_t uploaded = 0;
   std::uint64_t bytes_uploaded = 0;
   std::vector<LoadFailure> failures;
+  /// Vulkan only: validation-layer warnings and errors (0 without --validation).
+  std::optional<std::uint64_t> validation_messages;
   void add(const FrameReport& r) {
     requests += r.stats.brick_requests + r.stats.node_requests;
     dropped += r.stats.backend.requests_dropped;
@@ -116,6 +119,7 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   nlohmann::json f = nlohmann::json::array();
   for (const LoadFailure& x : t.failures) f.push_back(x.message);
   j["load_failures"] = f;
+  if (t.validation_messages) j["validation_messages"] = *t.validation_messages;
   const std::string text = j.dump(2) + "\n";
   AtomicFileWriter w(path);
   w.append(std::as_bytes(std::span(text.data(), text.size())));
@@ -208,6 +212,18 @@ int run(const Args& a) {
   if (n != 0) steady /= double(n);
   const std::uint32_t tail = std::uint32_t(n);
 
+#ifdef RESOCT_RENDER_WITH_VULKAN
+  if (const auto* vb = dynamic_cast<const resoct::vk::VulkanBackend*>(&renderer.backend())) {
+    totals.validation_messages = vb->validation_messages();
+    for (const std::string& m : vb->validation_log()) {
+      std::fprintf(stderr, "resoct-render: validation: %s\n", m.c_str());
+    }
+    if (a.validation) {
+      std::fprintf(stderr, "resoct-render: %llu validation messages\n",
+                   static_cast<unsigned long long>(*totals.validation_messages));
+    }
+  }
+#endif
   if (!a.out.empty()) write_png(last.image, a.out);
   if (!a.stats.empty()) {
     write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer);

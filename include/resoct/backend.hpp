@@ -47,6 +47,9 @@ struct BackendConfig {
   std::uint64_t node_words = 0;    ///< words of the octree (ResidencyOctree::words())
   std::uint32_t brick_request_capacity = 1u << 16;  ///< device request set sizes
   std::uint32_t node_request_capacity = 1u << 14;
+  /// Brick bytes the frame loop uploads per frame at most (its UploadBudget); 0 = unknown. A
+  /// backend may size staging memory from it; larger updates must still work.
+  std::uint64_t upload_bytes_per_frame = 0;
 };
 
 /// One brick to place into a cache slot: padded voxels of BackendConfig::voxel_type.

@@ -1,16 +1,28 @@
 #pragma once
 // Internal: the state behind VulkanBackend, shared by its translation units
-// (vulkan_backend.cpp: configure/render; backend_state.cpp: buffers, descriptors, submission;
-// frame_upload.cpp: update() and the per-frame tables; readback.cpp: results and debug reads).
+// (vulkan_backend.cpp: configure/render; backend_state.cpp: buffers, descriptors, command batch;
+// frame_upload.cpp: update() and the per-frame tables through the staging ring; readback.cpp:
+// results and debug reads).
+//
+// Every device array lives in device-local memory (MemoryUse::device). Host data reaches it only
+// through the staging ring: bricks and full arrays by vkCmdCopyBuffer, page-table and octree
+// deltas as (index, value) pairs applied by the scatter pass. Results come back by copying into
+// one host-visible readback buffer. Commands accumulate in one batch (update() calls, then
+// render()) that is submitted and waited for at the end of render(), when the ring is full, or
+// before a debug read; consecutive operations are ordered by full memory barriers.
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
+#include <utility>
 
 #include <vulkan/vulkan.h>
 
 #include "device_memory.hpp"
 #include "pipelines.hpp"
+#include "scatter_pass.hpp"
+#include "staging_ring.hpp"
 #include "resoct/vulkan/vulkan_backend.hpp"
 #include "timing.hpp"
 #include "vk_context.hpp"
@@ -55,12 +67,29 @@ struct PushConstants {
 };
 
 constexpr std::uint32_t kWorkgroup = 8;
-// kernel/tf.glsl.h RESOCT_TF_LUT_SIZE (that header needs the accessors, which live in the shader).
-constexpr std::size_t kTfLutSize = 1024;
 constexpr std::uint32_t kMaxProbes = 16;  // RequestSet's default, which the CPU backend uses
 constexpr std::uint32_t kStatWords = 20;
 constexpr double kDistanceScale = 1048576.0;  // shaders/render.comp DISTANCE_SCALE
 constexpr std::uint64_t kFenceTimeoutNs = 120ull * 1000 * 1000 * 1000;
+// Staging ring size: the frame loop's brick budget plus room for deltas and tables, within
+// [kMinRing, kMaxRing]; 16 MiB when the budget is unknown. Larger updates flush mid-way.
+constexpr VkDeviceSize kRingHeadroom = 1ull << 20;
+constexpr VkDeviceSize kMinRing = 1ull << 20;
+constexpr VkDeviceSize kMaxRing = 256ull << 20;
+constexpr VkDeviceSize kDefaultRing = 16ull << 20;
+
+/// Usage of every device-local array: shader access plus transfers in both directions (uploads,
+/// clears, readback).
+constexpr VkBufferUsageFlags kDeviceUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+
+/// Byte offsets of a frame's outputs in the readback buffer.
+struct ReadbackLayout {
+  VkDeviceSize image = 0, brick_requests = 0, node_requests = 0, used = 0, stats = 0, total = 0;
+};
+ReadbackLayout readback_layout(std::size_t pixels, std::uint32_t brick_capacity,
+                               std::uint32_t node_capacity, std::uint32_t cache_slots);
 
 }  // namespace detail
 
@@ -76,8 +105,12 @@ struct VulkanBackend::Impl {
   VkFence fence = VK_NULL_HANDLE;
   std::unique_ptr<detail::ComputePipelines> render_pipelines;
   std::unique_ptr<detail::GpuTimer> timer;
-  std::array<detail::Buffer, detail::binding_count> buf{};
+  std::unique_ptr<detail::ScatterPass> scatter;
+  std::array<detail::Buffer, detail::binding_count> buf{};  // device-local
+  detail::StagingRing ring;
+  detail::Buffer readback;  // host-visible: frame results and debug reads
   bool descriptors_dirty = true;
+  bool recording = false;  // `cmd` holds an unsubmitted batch
 
   BackendConfig config{};
   bool configured = false;
@@ -87,19 +120,36 @@ struct VulkanBackend::Impl {
   std::uint32_t slots_per_chunk = 1;     // cache slots per cache buffer
   std::uint32_t chunks = 1;              // cache buffers in use
   std::uint64_t cache_buffer_limit = 0;  // test override of maxStorageBufferRange (0 = none)
+  VkDeviceSize ring_limit = 0;           // test override of the staging ring size (0 = none)
 
   explicit Impl(std::unique_ptr<detail::Context> c);
   ~Impl();
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  /// Where cache slot `slot` starts: its chunk's mapping plus the byte offset in it.
-  std::byte* slot_address(std::uint32_t slot) const;
+  /// Where cache slot `slot` starts: its chunk's buffer and the byte offset in it.
+  std::pair<VkBuffer, VkDeviceSize> slot_location(std::uint32_t slot) const;
   void release_buffers() noexcept;
-  /// Makes buffer `b` hold at least `bytes` (grows geometrically; contents are not kept).
+  /// Makes device buffer `b` hold at least `bytes` (grows geometrically; contents are not kept).
+  /// Only between batches: a recorded command may use the old buffer.
   void ensure(detail::Binding b, VkDeviceSize bytes, const char* what);
+  /// Makes the readback buffer hold at least `bytes`; only between batches.
+  void ensure_readback(VkDeviceSize bytes);
   void write_descriptors();
-  void submit_and_wait();
+
+  /// Starts a batch unless one is being recorded; a new batch begins with a barrier against
+  /// everything submitted before.
+  void begin_batch();
+  /// Submits the batch, waits for it and recycles the staging ring (no-op without a batch).
+  void flush();
+  /// Orders all earlier transfer/compute writes before all later transfer/compute accesses.
+  void barrier();
+  /// Copies `bytes` to `dst` at `offset` through the ring (split and flushed as needed).
+  void stage_copy(VkBuffer dst, VkDeviceSize offset, std::span<const std::byte> bytes);
+  /// Applies (index, value) pairs to a device array through the ring and the scatter pass.
+  /// Indices must be in range and unique (later duplicates removed by the caller).
+  void stage_scatter(detail::ScatterTarget target, std::span<const std::uint32_t> pairs,
+                     std::uint32_t target_words);
 
   /// The specialization constants of this frame's render pipeline (see pipelines.hpp).
   detail::RenderVariant render_variant(const FrameTables& tables) const;
@@ -107,7 +157,14 @@ struct VulkanBackend::Impl {
   void upload_tables(const FrameTables& tables);
   /// Records clearing the per-frame outputs, the dispatch and the barriers around it.
   void record_render(const kernel::ResoctFrame& frame, VkPipeline pipeline);
-  /// Image, statistics, requests and used slots of the finished frame.
+  /// Where a frame of `pixels` pixels puts its outputs in the readback buffer.
+  detail::ReadbackLayout readback_layout(std::size_t pixels) const;
+  /// Ends an unsubmitted batch without running it (configure() replaces all state anyway).
+  void discard_batch() noexcept;
+  /// Records copying the frame's outputs (image, statistics, request sets, used bits) into the
+  /// readback buffer, followed by a barrier to host reads.
+  void record_readback(const kernel::ResoctFrame& frame);
+  /// Image, statistics, requests and used slots of the finished frame from the readback buffer.
   void read_results(const kernel::ResoctFrame& frame, FrameResult& result) const;
 };
 

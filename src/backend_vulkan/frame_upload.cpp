@@ -1,8 +1,9 @@
 // Host → device: VulkanBackend::update() (bricks, page table, octree words) and the per-frame
-// tables of render().
+// tables of render(), all through the staging ring (see backend_impl.hpp).
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "backend_impl.hpp"
 #include "resoct/error.hpp"
@@ -11,17 +12,42 @@ namespace resoct::vk {
 
 using namespace detail;
 
+namespace {
+
+// Flattens word deltas into (index, value) pairs with one pair per index, the last delta of an
+// index winning (the order in which FrameUpdate lists them), so that scatter invocations never
+// race on a word.
+template <class Delta>
+std::vector<std::uint32_t> unique_pairs(std::span<const Delta> deltas) {
+  std::vector<std::uint32_t> order(deltas.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return deltas[a].index < deltas[b].index;
+  });
+  std::vector<std::uint32_t> pairs;
+  pairs.reserve(2 * deltas.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Delta& d = deltas[order[k]];
+    if (k + 1 < order.size() && deltas[order[k + 1]].index == d.index) continue;
+    pairs.push_back(std::uint32_t(d.index));
+    pairs.push_back(d.value);
+  }
+  return pairs;
+}
+
+std::span<const std::byte> bytes_of(std::span<const std::uint32_t> words) {
+  return std::as_bytes(words);
+}
+
+}  // namespace
+
 void VulkanBackend::update(const FrameUpdate& u) {
   Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("update", "backend is not configured");
   const std::size_t brick_bytes = m.slot_voxels * m.voxel_bytes;
-  auto* pages = static_cast<std::uint32_t*>(m.buf[b_pages].mapped);
-  auto* offsets = static_cast<std::uint32_t*>(m.buf[b_page_offsets].mapped);
-  auto* nodes = static_cast<std::uint32_t*>(m.buf[b_nodes].mapped);
   const std::size_t page_count = m.config.page_entries;
   const std::size_t node_count = std::size_t(m.config.node_words);
-  // The device is idle between calls (render() waits), so writing through the mapping is the
-  // scatter; host-coherent memory makes it visible to the next submission.
+  // Validate everything before recording anything, so that a rejected update changes nothing.
   for (const BrickUpload& b : u.bricks) {
     if (b.cache_slot >= m.config.cache_slots) {
       throw invalid_parameter("update", "cache slot " + std::to_string(b.cache_slot) +
@@ -32,7 +58,6 @@ void VulkanBackend::update(const FrameUpdate& u) {
       throw invalid_parameter("update", "brick of " + std::to_string(b.voxels.size()) +
                                             " bytes, expected " + std::to_string(brick_bytes));
     }
-    std::memcpy(m.slot_address(b.cache_slot), b.voxels.data(), brick_bytes);
   }
   if (u.pages_full) {
     if (u.all_pages.size() != page_count) {
@@ -45,29 +70,65 @@ void VulkanBackend::update(const FrameUpdate& u) {
     for (std::uint32_t o : u.page_table_offsets) {
       if (o > page_count) throw invalid_parameter("update", "page table offset out of range");
     }
-    std::copy(u.all_pages.begin(), u.all_pages.end(), pages);
-    std::copy(u.page_table_offsets.begin(), u.page_table_offsets.end(), offsets);
   }
   for (const PageDelta& d : u.page_deltas) {
     if (d.index >= page_count) throw invalid_parameter("update", "page delta out of range");
-    pages[d.index] = d.value;
   }
-  if (u.nodes_full) {
-    if (u.all_nodes.size() != node_count) {
-      throw invalid_parameter("update", "full octree of " + std::to_string(u.all_nodes.size()) +
-                                            " words, expected " + std::to_string(node_count));
-    }
-    std::copy(u.all_nodes.begin(), u.all_nodes.end(), nodes);
+  if (u.nodes_full && u.all_nodes.size() != node_count) {
+    throw invalid_parameter("update", "full octree of " + std::to_string(u.all_nodes.size()) +
+                                          " words, expected " + std::to_string(node_count));
   }
   for (const OctreeWordDelta& d : u.node_deltas) {
     if (d.index >= node_count) throw invalid_parameter("update", "octree delta out of range");
-    nodes[d.index] = d.value;
+  }
+
+  // Bricks: the last upload of a slot wins; distinct slots are disjoint copy regions.
+  std::vector<std::uint32_t> last(u.bricks.size());
+  {
+    std::vector<std::uint32_t> order(u.bricks.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return u.bricks[a].cache_slot < u.bricks[b].cache_slot;
+    });
+    last.clear();
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      if (k + 1 < order.size() &&
+          u.bricks[order[k + 1]].cache_slot == u.bricks[order[k]].cache_slot) {
+        continue;
+      }
+      last.push_back(order[k]);
+    }
+  }
+  const auto page_pairs = unique_pairs(u.page_deltas);
+  const auto node_pairs = unique_pairs(u.node_deltas);
+  if (last.empty() && !u.pages_full && page_pairs.empty() && !u.nodes_full && node_pairs.empty()) {
+    return;
+  }
+  m.begin_batch();
+  // Earlier updates in this batch may have written the same words: order against them.
+  m.barrier();
+  for (std::uint32_t i : last) {
+    const auto [buffer, offset] = m.slot_location(u.bricks[i].cache_slot);
+    m.stage_copy(buffer, offset, u.bricks[i].voxels);
+  }
+  // The CPU backend applies a full array before the deltas of the same update; so does this.
+  if (u.pages_full) {
+    m.stage_copy(m.buf[b_pages].buffer, 0, bytes_of(u.all_pages));
+    m.stage_copy(m.buf[b_page_offsets].buffer, 0, bytes_of(u.page_table_offsets));
+  }
+  if (u.nodes_full) m.stage_copy(m.buf[b_nodes].buffer, 0, bytes_of(u.all_nodes));
+  if (!page_pairs.empty() || !node_pairs.empty()) {
+    m.begin_batch();
+    if (u.pages_full || u.nodes_full) m.barrier();
+    m.stage_scatter(ScatterTarget::pages, page_pairs, std::uint32_t(page_count));
+    m.stage_scatter(ScatterTarget::nodes, node_pairs, std::uint32_t(node_count));
   }
 }
 
 void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   const kernel::ResoctFrame& frame = tables.frame;
   const std::size_t pixels = std::size_t(frame.width) * frame.height;
+  // Buffers may be recreated here, so nothing recorded may refer to them yet.
   ensure(b_slots, std::max<std::size_t>(tables.slots.size(), 1) * sizeof(kernel::ResoctSlotInfo),
          "slot table");
   ensure(b_levels, tables.levels.size() * sizeof(kernel::ResoctLevelInfo), "level table");
@@ -75,14 +136,12 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   ensure(b_tf, std::max<std::size_t>(tables.tf_luts.size(), 1) * sizeof(glm::vec4),
          "transfer functions");
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
-  std::memcpy(buf[b_frame].mapped, &frame, sizeof(frame));
-  std::memcpy(buf[b_slots].mapped, tables.slots.data(),
-              tables.slots.size() * sizeof(tables.slots[0]));
-  std::memcpy(buf[b_levels].mapped, tables.levels.data(),
-              tables.levels.size() * sizeof(tables.levels[0]));
-  std::memcpy(buf[b_depths].mapped, tables.depths.data(),
-              tables.depths.size() * sizeof(tables.depths[0]));
-  std::memcpy(buf[b_tf].mapped, tables.tf_luts.data(), tables.tf_luts.size() * sizeof(glm::vec4));
+  begin_batch();
+  stage_copy(buf[b_frame].buffer, 0, std::as_bytes(std::span(&frame, 1)));
+  stage_copy(buf[b_slots].buffer, 0, std::as_bytes(std::span(tables.slots)));
+  stage_copy(buf[b_levels].buffer, 0, std::as_bytes(std::span(tables.levels)));
+  stage_copy(buf[b_depths].buffer, 0, std::as_bytes(std::span(tables.depths)));
+  stage_copy(buf[b_tf].buffer, 0, std::as_bytes(std::span(tables.tf_luts)));
 }
 
 }  // namespace resoct::vk

@@ -42,6 +42,14 @@ struct RenderVariant {
   friend auto operator<=>(const RenderVariant&, const RenderVariant&) = default;
 };
 
+/// Specialization constants of shaders/scatter.comp.
+struct ScatterVariant {
+  std::uint32_t workgroup_x = 64;  ///< local_size_x_id
+
+  static constexpr std::array<std::uint32_t, 1> constant_ids = {0};
+  friend auto operator<=>(const ScatterVariant&, const ScatterVariant&) = default;
+};
+
 /// One shader module and its pipelines; not thread-safe (the backend is single-threaded).
 class ComputePipelines {
  public:

@@ -34,15 +34,53 @@ void drain(const std::uint32_t* set, std::uint32_t cap, std::uint32_t level_coun
 
 }  // namespace
 
+ReadbackLayout detail::readback_layout(std::size_t pixels, std::uint32_t brick_capacity,
+                                       std::uint32_t node_capacity, std::uint32_t cache_slots) {
+  ReadbackLayout l;
+  l.image = 0;
+  l.brick_requests = VkDeviceSize(pixels) * sizeof(glm::vec4);
+  l.node_requests = l.brick_requests + VkDeviceSize(brick_capacity) * 8;
+  l.used = l.node_requests + VkDeviceSize(node_capacity) * 8;
+  l.stats = l.used + (VkDeviceSize(cache_slots) + 31) / 32 * 4;
+  l.total = l.stats + kStatWords * 4;
+  return l;
+}
+
+ReadbackLayout VulkanBackend::Impl::readback_layout(std::size_t pixels) const {
+  return detail::readback_layout(pixels, brick_capacity, node_capacity, config.cache_slots);
+}
+
+void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame) {
+  const ReadbackLayout l = readback_layout(std::size_t(frame.width) * frame.height);
+  barrier();
+  auto copy = [&](Binding b, VkDeviceSize to, VkDeviceSize bytes) {
+    if (bytes == 0) return;
+    const VkBufferCopy region{0, to, bytes};
+    vkCmdCopyBuffer(cmd, buf[b].buffer, readback.buffer, 1, &region);
+  };
+  copy(b_out, l.image, l.brick_requests - l.image);
+  copy(b_brick_requests, l.brick_requests, l.node_requests - l.brick_requests);
+  copy(b_node_requests, l.node_requests, l.used - l.node_requests);
+  copy(b_used, l.used, l.stats - l.used);
+  copy(b_stats, l.stats, l.total - l.stats);
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
+}
+
 void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
                                        FrameResult& result) const {
   const std::size_t pixels = std::size_t(frame.width) * frame.height;
+  const ReadbackLayout l = readback_layout(pixels);
+  const auto* base = static_cast<const std::byte*>(readback.mapped);
   if (result.image.width() != frame.width || result.image.height() != frame.height) {
     result.image = Image(frame.width, frame.height);
   }
-  std::memcpy(result.image.pixels().data(), buf[b_out].mapped, pixels * sizeof(glm::vec4));
+  std::memcpy(result.image.pixels().data(), base + l.image, pixels * sizeof(glm::vec4));
 
-  const auto* st = static_cast<const std::uint32_t*>(buf[b_stats].mapped);
+  const auto* st = reinterpret_cast<const std::uint32_t*>(base + l.stats);
   auto stat = [st](std::uint32_t i) {
     return std::uint64_t(st[i]) | (std::uint64_t(st[i + 1]) << 32);
   };
@@ -60,13 +98,13 @@ void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
   s.distance_marched = double(stat(18)) / kDistanceScale;
   s.ms_device = timer->ms();
 
-  drain(static_cast<const std::uint32_t*>(buf[b_brick_requests].mapped), brick_capacity,
+  drain(reinterpret_cast<const std::uint32_t*>(base + l.brick_requests), brick_capacity,
         frame.level_count, result.brick_requests);
-  drain(static_cast<const std::uint32_t*>(buf[b_node_requests].mapped), node_capacity, 0,
+  drain(reinterpret_cast<const std::uint32_t*>(base + l.node_requests), node_capacity, 0,
         result.node_requests);
 
   result.used_cache_slots.clear();
-  const auto* used = static_cast<const std::uint32_t*>(buf[b_used].mapped);
+  const auto* used = reinterpret_cast<const std::uint32_t*>(base + l.used);
   for (std::size_t w = 0; w < (std::size_t(config.cache_slots) + 31) / 32; ++w) {
     std::uint32_t bits = used[w];
     while (bits != 0) {
@@ -78,9 +116,10 @@ void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
 }
 
 std::vector<std::byte> VulkanBackend::debug_read(DeviceArray array) const {
-  const Impl& m = *impl_;
+  Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("array", "backend is not configured");
-  check(vkDeviceWaitIdle(m.ctx->device), "vkDeviceWaitIdle");
+  // Apply pending updates first: the read must see them.
+  m.flush();
   std::size_t bytes = 0;
   Binding b = b_cache;
   switch (array) {
@@ -101,14 +140,31 @@ std::vector<std::byte> VulkanBackend::debug_read(DeviceArray array) const {
       break;
   }
   std::vector<std::byte> out(bytes);
+  if (bytes == 0) return out;
+  m.ensure_readback(bytes);
+  m.begin_batch();
   if (array == DeviceArray::cache) {
-    const std::size_t brick_bytes = m.slot_voxels * m.voxel_bytes;
-    for (std::uint32_t s = 0; s < m.config.cache_slots; ++s) {
-      std::memcpy(out.data() + std::size_t(s) * brick_bytes, m.slot_address(s), brick_bytes);
+    // Chunk c holds slots [c * slots_per_chunk, ...) from its offset 0.
+    const VkDeviceSize chunk_bytes =
+        VkDeviceSize(m.slots_per_chunk) * m.slot_voxels * m.voxel_bytes;
+    for (std::uint32_t c = 0; c < m.chunks; ++c) {
+      const VkDeviceSize from = c * chunk_bytes;
+      const VkDeviceSize n = std::min<VkDeviceSize>(chunk_bytes, bytes - from);
+      const VkBufferCopy region{0, from, n};
+      vkCmdCopyBuffer(m.cmd, m.buf[cache_binding(c)].buffer, m.readback.buffer, 1, &region);
     }
-  } else if (bytes) {
-    std::memcpy(out.data(), m.buf[b].mapped, bytes);
+  } else {
+    const VkBufferCopy region{0, 0, bytes};
+    vkCmdCopyBuffer(m.cmd, m.buf[b].buffer, m.readback.buffer, 1, &region);
   }
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(m.cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
+  m.flush();
+  invalidate(*m.ctx, m.readback);
+  std::memcpy(out.data(), m.readback.mapped, bytes);
   return out;
 }
 

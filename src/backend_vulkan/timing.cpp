@@ -19,7 +19,8 @@ GpuTimer::~GpuTimer() {
 void GpuTimer::begin(VkCommandBuffer cmd) const {
   if (!pool_) return;
   vkCmdResetQueryPool(cmd, pool_, 0, 2);
-  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, pool_, 0);
+  // After everything recorded before it (uploads, clears): the interval is the dispatch alone.
+  vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, pool_, 0);
 }
 
 void GpuTimer::end(VkCommandBuffer cmd) const {

@@ -17,7 +17,7 @@ class GpuTimer {
   GpuTimer(const GpuTimer&) = delete;
   GpuTimer& operator=(const GpuTimer&) = delete;
 
-  /// Records the query reset and the first timestamp (top of pipe).
+  /// Records the query reset and the first timestamp, once all earlier commands completed.
   void begin(VkCommandBuffer cmd) const;
   /// Records the second timestamp (bottom of pipe).
   void end(VkCommandBuffer cmd) const;

@@ -41,6 +41,16 @@ bool layer_available(const char* name) {
   });
 }
 
+bool layer_extension_available(const char* layer, const char* name) {
+  std::uint32_t n = 0;
+  vkEnumerateInstanceExtensionProperties(layer, &n, nullptr);
+  std::vector<VkExtensionProperties> ext(n);
+  vkEnumerateInstanceExtensionProperties(layer, &n, ext.data());
+  return std::any_of(ext.begin(), ext.end(), [&](const VkExtensionProperties& e) {
+    return std::strcmp(e.extensionName, name) == 0;
+  });
+}
+
 bool device_extension_available(VkPhysicalDevice p, const char* name) {
   std::uint32_t n = 0;
   vkEnumerateDeviceExtensionProperties(p, nullptr, &n, nullptr);
@@ -109,6 +119,15 @@ void fill_properties(Context& c) {
                 "device: queue family " + std::to_string(c.family) + " has no compute queue");
   }
   c.timestamp_bits = c.props.limits.timestampPeriod > 0.0f ? q[c.family].timestampValidBits : 0u;
+  if (c.props.apiVersion >= VK_API_VERSION_1_2) {
+    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    p2.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(c.physical, &p2);
+    // llvmpipe's guard against endless loops (Mesa gallivm LP_MAX_TGSI_LOOP_ITERATIONS): one
+    // counter per invocation batch, decremented at every loop back-edge of the shader.
+    if (driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE) c.loop_limit = 65535;
+  }
   vkGetDeviceQueue(c.device, c.family, 0, &c.queue);
 }
 
@@ -151,14 +170,25 @@ std::unique_ptr<Context> create_context(const BackendOptions& options) {
   app.pApplicationName = "resoct";
   app.apiVersion = VK_API_VERSION_1_2;
   const char* layers[] = {kValidationLayer};
-  const char* instance_ext[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+  const char* instance_ext[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME,
+                                VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   ici.pApplicationInfo = &app;
+  // Synchronization validation as well: missing or wrong barriers between the staged copies,
+  // scatters, the dispatch and the readback are reported like any other validation error.
+  const VkValidationFeatureEnableEXT sync =
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = &sync;
   if (validation) {
+    const bool has_features =
+        layer_extension_available(kValidationLayer, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
     ici.enabledLayerCount = 1;
     ici.ppEnabledLayerNames = layers;
-    ici.enabledExtensionCount = 1;
+    ici.enabledExtensionCount = has_features ? 2u : 1u;
     ici.ppEnabledExtensionNames = instance_ext;
+    if (has_features) ici.pNext = &features;
   }
   check(vkCreateInstance(&ici, nullptr, &c->instance), "vkCreateInstance");
   if (validation) {

@@ -30,6 +30,7 @@ struct Context {
   VkPhysicalDeviceMemoryProperties memory{};
   bool has_budget = false;
   std::uint32_t timestamp_bits = 0;
+  std::uint32_t loop_limit = 0;  ///< loop back-edges per invocation the driver allows (0 = none)
   std::atomic<std::uint64_t> messages{0};
   mutable std::mutex log_mutex;
   std::vector<std::string> log;

@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <string>
 
@@ -47,6 +48,10 @@ VulkanBackend::~VulkanBackend() = default;
 
 std::string VulkanBackend::device_name() const {
   return impl_->ctx->props.deviceName;
+}
+
+std::uint32_t VulkanBackend::loop_iteration_limit() const noexcept {
+  return impl_->ctx->loop_limit;
 }
 
 std::uint64_t VulkanBackend::validation_messages() const noexcept {
@@ -113,10 +118,26 @@ void VulkanBackend::configure(const BackendConfig& config) {
     }
     total += bytes;
   }
+  // Staging ring: the frame loop's upload budget plus headroom for deltas and tables.
+  VkDeviceSize ring_bytes =
+      config.upload_bytes_per_frame == 0
+          ? kDefaultRing
+          : std::clamp<VkDeviceSize>(config.upload_bytes_per_frame + kRingHeadroom, kMinRing,
+                                     kMaxRing);
+  if (m.ring_limit != 0) ring_bytes = std::min(ring_bytes, m.ring_limit);
+  ring_bytes = std::min<VkDeviceSize>(ring_bytes, m.ctx->props.limits.maxStorageBufferRange & ~15u);
+  const VkDeviceSize readback_bytes =
+      readback_layout(0, brick_cap, node_cap, config.cache_slots).total;
+  std::map<std::uint32_t, VkDeviceSize> plan;
+  plan[heap_of(*m.ctx, MemoryUse::device)] += total;
+  plan[heap_of(*m.ctx, MemoryUse::upload)] += ring_bytes;
+  plan[heap_of(*m.ctx, MemoryUse::readback)] += readback_bytes;
+
   m.configured = false;
+  m.discard_batch();
   check(vkDeviceWaitIdle(m.ctx->device), "vkDeviceWaitIdle");
   m.release_buffers();
-  detail::check_budget(*m.ctx, total);
+  check_budget(*m.ctx, plan);
   m.config = config;
   m.voxel_bytes = std::size_t(vb);
   m.slot_voxels = std::size_t(slot_voxels);
@@ -135,6 +156,18 @@ void VulkanBackend::configure(const BackendConfig& config) {
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");
   m.ensure(b_frame, sizeof(kernel::ResoctFrame), "frame constants");
+  m.ring.create(*m.ctx, ring_bytes);
+  m.ensure_readback(readback_bytes);
+  m.scatter->bind(ScatterTarget::pages, m.ring.buffer(), m.ring.capacity(), m.buf[b_pages].buffer,
+                  m.buf[b_pages].size);
+  m.scatter->bind(ScatterTarget::nodes, m.ring.buffer(), m.ring.capacity(), m.buf[b_nodes].buffer,
+                  m.buf[b_nodes].size);
+  // All state reads as zero after configure().
+  m.begin_batch();
+  for (const Buffer& b : m.buf) {
+    if (b.buffer != VK_NULL_HANDLE) vkCmdFillBuffer(m.cmd, b.buffer, 0, VK_WHOLE_SIZE, 0);
+  }
+  m.flush();
   // The pipeline is built by the first render(): compiling the kernel takes seconds on CPU
   // devices, and a configuration that is only updated never needs it.
   m.configured = true;
@@ -153,10 +186,9 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& /*tables*/)
 }
 
 void VulkanBackend::Impl::record_render(const kernel::ResoctFrame& frame, VkPipeline pipeline) {
-  check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+  begin_batch();
+  // Table copies and delta scatters of this batch are done before the clears and the dispatch.
+  barrier();
   // Clear the per-frame outputs on the device: request keys to "free", counts and bits to 0.
   vkCmdFillBuffer(cmd, buf[b_brick_requests].buffer, 0, VkDeviceSize(brick_capacity) * 4,
                   kernel::RESOCT_REQUEST_KEY_NONE);
@@ -168,12 +200,7 @@ void VulkanBackend::Impl::record_render(const kernel::ResoctFrame& frame, VkPipe
                   VkDeviceSize(node_capacity) * 4, 0);
   vkCmdFillBuffer(cmd, buf[b_used].buffer, 0, VK_WHOLE_SIZE, 0);
   vkCmdFillBuffer(cmd, buf[b_stats].buffer, 0, VK_WHOLE_SIZE, 0);
-  VkMemoryBarrier to_shader{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  to_shader.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
-  to_shader.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &to_shader, 0, nullptr, 0,
-                       nullptr);
+  barrier();
   timer->begin(cmd);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout, 0, 1, &set, 0,
@@ -186,12 +213,7 @@ void VulkanBackend::Impl::record_render(const kernel::ResoctFrame& frame, VkPipe
   vkCmdDispatch(cmd, (frame.width + kWorkgroup - 1) / kWorkgroup,
                 (frame.height + kWorkgroup - 1) / kWorkgroup, 1);
   timer->end(cmd);
-  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
-                       &to_host, 0, nullptr, 0, nullptr);
-  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  record_readback(frame);
 }
 
 void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
@@ -199,12 +221,14 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
   Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("tables", "backend is not configured");
   check_frame_tables(tables, m.config);
+  m.ensure_readback(m.readback_layout(std::size_t(tables.frame.width) * tables.frame.height).total);
   m.upload_tables(tables);
   m.write_descriptors();
   // Compiling the kernel is slow (seconds on lavapipe): the cache compiles each variant once.
   const VkPipeline pipeline = m.render_pipelines->get(m.render_variant(tables));
   m.record_render(tables.frame, pipeline);
-  m.submit_and_wait();
+  m.flush();
+  invalidate(*m.ctx, m.readback);
   m.read_results(tables.frame, result);
   result.stats.ms_render =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -212,6 +236,10 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
 
 void VulkanBackend::debug_limit_cache_buffer(std::uint64_t bytes) noexcept {
   impl_->cache_buffer_limit = bytes;
+}
+
+void VulkanBackend::debug_limit_staging_ring(std::uint64_t bytes) noexcept {
+  impl_->ring_limit = bytes;
 }
 
 std::size_t VulkanBackend::debug_pipeline_count() const noexcept {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -99,6 +100,15 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
   config_.node_words = octree_->words().size();
   config_.brick_request_capacity = options_.brick_request_capacity;
   config_.node_request_capacity = options_.node_request_capacity;
+  {
+    // min(max_bricks x brick bytes, max_bytes) without overflowing the "unlimited" defaults.
+    const std::uint64_t brick =
+        hierarchy_.layout().padded_voxels() * voxel_size(hierarchy_.volume().type);
+    const std::uint64_t b = options_.upload_budget.max_bricks;
+    const std::uint64_t by_count =
+        b > std::numeric_limits<std::uint64_t>::max() / brick ? ~0ull : b * brick;
+    config_.upload_bytes_per_frame = std::min(by_count, options_.upload_budget.max_bytes);
+  }
   backend_->configure(config_);
 }
 

@@ -1,13 +1,18 @@
 // resoct-render as a process: renders the shipped scenes from procedural volumes and from a brick
 // store in every mode, writes a readable PNG and a stats.json with the documented fields, and
-// fails with one line naming the bad parameter or file, leaving no output behind.
+// fails with one line naming the bad parameter or file, leaving no output behind. With the Vulkan
+// backend built: lists the devices (lavapipe where its ICD is installed), renders every mode with
+// --backend vulkan under validation like the CPU backend, and rejects a bad --device in one line.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -101,6 +106,111 @@ TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
     EXPECT_FALSE(std::filesystem::exists(stats)) << c.args;
     const std::string last_line = r.err.substr(r.err.rfind('\n', r.err.size() - 2) + 1);
     EXPECT_NE(last_line.find("error"), std::string::npos) << r.err;
+  }
+}
+
+// Why the Vulkan tool tests cannot run here, or "" when they can.
+std::string vulkan_skip_reason(const TempDir& dir) {
+  const ToolRun r = run(dir, RESOCT_RENDER, "--list-devices");
+  if (r.err.find("no Vulkan backend") != std::string::npos) return "built without Vulkan";
+  if (r.out.find("no Vulkan device") != std::string::npos) return "no Vulkan device";
+  return "";
+}
+
+std::size_t line_count(const std::string& s) {
+  return std::size_t(std::count(s.begin(), s.end(), '\n'));
+}
+
+TEST(RenderTool, ListDevicesPrintsEveryDeviceAndLavapipe) {
+  TempDir dir;
+  if (const std::string why = vulkan_skip_reason(dir); !why.empty()) GTEST_SKIP() << why;
+  const ToolRun r = run(dir, RESOCT_RENDER, "--list-devices");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // "0: <name> (<type>, Vulkan x.y.z, N MiB device-local)" per device, numbered from 0.
+  std::istringstream lines(r.out);
+  std::string line;
+  std::size_t n = 0;
+  while (std::getline(lines, line)) {
+    EXPECT_EQ(line.rfind(std::to_string(n) + ": ", 0), 0u) << line;
+    EXPECT_NE(line.find(", Vulkan 1."), std::string::npos) << line;
+    ++n;
+  }
+  EXPECT_GE(n, 1u);
+  // Mesa's lavapipe calls itself "llvmpipe"; CI installs it (issue 5: "CI without a GPU").
+  bool lavapipe_installed = false;
+  for (const char* dir_path : {"/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d"}) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir_path, ec)) {
+      lavapipe_installed |= e.path().filename().string().rfind("lvp_icd", 0) == 0;
+    }
+  }
+  if (lavapipe_installed) {
+    EXPECT_NE(r.out.find("llvmpipe"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(cpu, Vulkan"), std::string::npos) << r.out;
+  }
+}
+
+// Every mode on the Vulkan backend: converges, no validation message, and the image equals the
+// CPU backend's within 2/255 per channel plus one 8-bit quantization step.
+TEST(RenderTool, VulkanBackendRendersEveryModeLikeTheCpuBackend) {
+  TempDir dir;
+  if (const std::string why = vulkan_skip_reason(dir); !why.empty()) GTEST_SKIP() << why;
+  for (const char* mode : {"residency", "pagetable", "octree"}) {
+    std::map<std::string, resoct::Image> images;
+    for (const char* backend : {"cpu", "vulkan"}) {
+      const std::string stem = std::string(mode) + "-" + backend;
+      const std::string png = dir.file(stem + ".png"), stats = dir.file(stem + ".json");
+      // Small: lavapipe renders on the CPU, under validation.
+      const ToolRun r = run(dir, RESOCT_RENDER,
+                            "--volume procedural:tubes:32x32x32 --scene '" + scene("tubes") +
+                                "' --width 24 --height 16 --converge --steady-frames 1 --threads 1"
+                                " --out '" +
+                                png + "' --stats '" + stats + "' --mode " + mode + " --backend " +
+                                backend + " --validation");
+      ASSERT_EQ(r.exit_code, 0) << stem << ": " << r.err;
+      const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+      EXPECT_EQ(j["backend"], backend);
+      EXPECT_EQ(j["mode"], mode);
+      EXPECT_TRUE(j["converged"].get<bool>()) << stem;
+      EXPECT_EQ(j["cap_hits"].get<std::uint64_t>(), 0u) << stem;
+      EXPECT_GT(j["samples_per_ray"].get<double>(), 0.0) << stem;
+      if (std::string(backend) == "vulkan") {
+        ASSERT_TRUE(j.contains("validation_messages")) << stem;
+        EXPECT_EQ(j["validation_messages"].get<std::uint64_t>(), 0u) << stem << ": " << r.err;
+        EXPECT_EQ(r.err.find("validation: "), std::string::npos) << r.err;
+      }
+      images.emplace(backend, resoct::read_png(png));
+    }
+    const resoct::Image& a = images.at("cpu");
+    const resoct::Image& b = images.at("vulkan");
+    ASSERT_EQ(a.width(), b.width());
+    ASSERT_EQ(a.height(), b.height());
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < a.pixels().size(); ++i) {
+      for (int c = 0; c < 4; ++c) {
+        worst = std::max(worst, std::abs(a.pixels()[i][c] - b.pixels()[i][c]));
+      }
+    }
+    EXPECT_LE(worst, 3.0f / 255.0f + 1e-6f) << mode;
+  }
+}
+
+TEST(RenderTool, BadVulkanDeviceFailsWithOneLine) {
+  TempDir dir;
+  if (const std::string why = vulkan_skip_reason(dir); why == "built without Vulkan") {
+    GTEST_SKIP() << why;
+  }
+  const std::string png = dir.file("x.png"), stats = dir.file("x.json");
+  for (const char* device : {"no-such-gpu-xyz", "999"}) {
+    const ToolRun r = run(dir, RESOCT_RENDER,
+                          render_args("procedural:tubes:32x32x32", scene("tubes"), png, stats) +
+                              " --backend vulkan --device " + device);
+    EXPECT_NE(r.exit_code, 0) << device;
+    EXPECT_EQ(line_count(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("error"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("device"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(png));
+    EXPECT_FALSE(std::filesystem::exists(stats));
   }
 }
 

@@ -31,13 +31,21 @@ TEST(VulkanInterop, RendersWithAnApplicationDevice) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.apiVersion = VK_API_VERSION_1_2;
   const char* layer = "VK_LAYER_KHRONOS_validation";
-  const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  const char* ext[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME,
+                       VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
+  // Synchronization validation too: the backend's barriers must satisfy it on a foreign device.
+  const VkValidationFeatureEnableEXT sync =
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = &sync;
   VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pNext = &features;
   ici.pApplicationInfo = &app;
   ici.enabledLayerCount = 1;
   ici.ppEnabledLayerNames = &layer;
-  ici.enabledExtensionCount = 1;
-  ici.ppEnabledExtensionNames = &ext;
+  ici.enabledExtensionCount = 2;
+  ici.ppEnabledExtensionNames = ext;
   VkInstance instance = VK_NULL_HANDLE;
   ASSERT_EQ(vkCreateInstance(&ici, nullptr, &instance), VK_SUCCESS);
   VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};

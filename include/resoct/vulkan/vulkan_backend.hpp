@@ -2,9 +2,12 @@
 /// \file
 /// The Vulkan compute backend: the single-source traversal kernel compiled to SPIR-V
 /// (src/backend_vulkan/shaders/render.comp), one invocation per pixel. Device state lives in
-/// storage buffers; the voxel cache is up to 8 buffers of whole bricks (one buffer may not exceed
-/// maxStorageBufferRange) holding voxels of the configured type filtered in the
-/// shader exactly like the CPU backend, so the CPU backend is its test oracle.
+/// device-local storage buffers, written only through a host-visible staging ring sized from
+/// BackendConfig::upload_bytes_per_frame (bricks by buffer copies, page-table and octree deltas
+/// as (index, value) pairs applied by a scatter shader). The voxel cache is up to 8 buffers of
+/// whole bricks (one buffer may not exceed maxStorageBufferRange) holding voxels of the configured
+/// type filtered in the shader exactly like the CPU backend, so the CPU backend is its test
+/// oracle. docs/vulkan-backend.md has the details.
 
 #include <cstddef>
 #include <cstdint>
@@ -25,8 +28,9 @@ void register_backend();
 /// Device arrays a test can read back (debug_read()).
 enum class DeviceArray : std::uint8_t { cache, pages, page_offsets, nodes };
 
-/// Not thread-safe: one Renderer drives it from one thread. Every call waits for the device, so
-/// the host may reuse its spans as soon as a call returns.
+/// Not thread-safe: one Renderer drives it from one thread. update() copies its input into the
+/// staging ring and render() waits for the device, so the host may reuse its spans as soon as a
+/// call returns.
 class VulkanBackend : public Backend {
  public:
   /// Creates its own instance and device. `options.device`: a decimal index into
@@ -49,7 +53,9 @@ class VulkanBackend : public Backend {
   /// As CpuBackend::configure; additionally Error(out_of_memory) when a buffer exceeds the
   /// device's storage-buffer range, its heap, or the VK_EXT_memory_budget budget.
   void configure(const BackendConfig& config) override;
-  /// As CpuBackend::update (same checks, same messages naming "update").
+  /// As CpuBackend::update (same checks, same messages naming "update"). Records the transfers;
+  /// they run with the next render() or debug_read(), or earlier when the staging ring is full.
+  /// The spans are copied into the ring before returning, so the host may reuse them.
   void update(const FrameUpdate& update) override;
   /// As CpuBackend::render; ms_device is measured with timestamp queries (0 when the queue has
   /// no timestamps). Error(device) on device loss.
@@ -57,6 +63,12 @@ class VulkanBackend : public Backend {
 
   /// Name of the physical device in use.
   std::string device_name() const;
+  /// Loop back-edges one shader invocation may take before the driver ends all its loops, or 0
+  /// when the driver has no such limit. Mesa's lavapipe has one (65535, counted over every loop
+  /// of the kernel: roughly 2000 march iterations of a simple ray); a ray it cuts short is
+  /// counted in BackendStats::cap_hits, like a ray stopped by max_iterations, never silently
+  /// rendered short.
+  std::uint32_t loop_iteration_limit() const noexcept;
   /// Validation-layer warnings and errors recorded so far (0 when validation is off).
   std::uint64_t validation_messages() const noexcept;
   /// The recorded validation messages (the first 64).
@@ -69,6 +81,9 @@ class VulkanBackend : public Backend {
   /// maxStorageBufferRange) from the next configure() on, so that tests exercise a cache split
   /// over several buffers. 0 restores the default.
   void debug_limit_cache_buffer(std::uint64_t bytes) noexcept;
+  /// Test support: caps the staging ring (bytes) from the next configure() on, so that tests
+  /// exercise updates split over several submissions. 0 restores the default.
+  void debug_limit_staging_ring(std::uint64_t bytes) noexcept;
   /// Test support: render pipelines compiled so far. Pipelines are cached per distinct set of
   /// specialization constants (voxel type, padded brick, cache buffers, ...), so reconfiguring
   /// back to an earlier configuration compiles nothing.

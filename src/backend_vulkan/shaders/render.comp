@@ -7,6 +7,7 @@
 // lerp order, `precise` so no FMA contraction), which keeps colours identical to the CPU oracle
 // and avoids the unorm rounding and reduced filter precision of hardware samplers.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 
 layout(local_size_x_id = 10, local_size_y_id = 11, local_size_z = 1) in;
 
@@ -96,28 +97,49 @@ layout(std430, binding = 11) buffer Used {
 layout(std430, binding = 12) writeonly buffer Out {
   vec4 pixels[];
 };
-// 64-bit counters as (low, high) uint pairs; see STAT_* below.
+// 64-bit counters as (low, high) uint pairs, counter k at words 2k and 2k + 1 (STAT_* below).
 layout(std430, binding = 13) buffer Stats {
   uint stats[];
 };
 
 const uint STAT_SAMPLES = 0u;
-const uint STAT_NODES = 2u;
-const uint STAT_ACCESSES = 4u;
-const uint STAT_ITERATIONS = 6u;
-const uint STAT_CAPS = 8u;
-const uint STAT_REQUESTS = 10u;
-const uint STAT_BRICK_DROPPED = 12u;
-const uint STAT_NODE_DROPPED = 14u;
-const uint STAT_SKIPPED = 16u;  // box units * 2^20, rounded per ray
-const uint STAT_MARCHED = 18u;
+const uint STAT_NODES = 1u;
+const uint STAT_ACCESSES = 2u;
+const uint STAT_ITERATIONS = 3u;
+const uint STAT_CAPS = 4u;
+const uint STAT_REQUESTS = 5u;
+const uint STAT_BRICK_DROPPED = 6u;
+const uint STAT_NODE_DROPPED = 7u;
+const uint STAT_SKIPPED = 8u;  // box units * 2^20, rounded per ray
+const uint STAT_MARCHED = 9u;
+const uint STAT_COUNT = 10u;
 const float DISTANCE_SCALE = 1048576.0;
 
+// Requests this invocation could not insert (private per invocation, reduced with the rest).
+uint g_brick_dropped = 0u;
+uint g_node_dropped = 0u;
+
+// Statistics are summed per workgroup in shared memory and added to the buffer with one atomic
+// per counter and workgroup (instead of one per invocation, which serializes on the same words).
+// Partial sums are exact 64-bit (lo, hi) pairs.
+const uint WORKGROUP = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+shared uvec2 partial[STAT_COUNT][WORKGROUP];
+
+uvec2 add64(uvec2 a, uvec2 b) {
+  uint carry;
+  uint lo = uaddCarry(a.x, b.x, carry);
+  return uvec2(lo, a.y + b.y + carry);
+}
+
 // Exact 64-bit sums without 64-bit atomics: a carry out of the low word bumps the high word.
-void stat_add(uint index, uint v) {
-  if (v == 0u) return;
-  uint old = atomicAdd(stats[index], v);
-  if (old + v < old) atomicAdd(stats[index + 1u], 1u);
+void stat_add64(uint counter, uvec2 v) {
+  uint i = 2u * counter;
+  uint hi = v.y;
+  if (v.x != 0u) {
+    uint old = atomicAdd(stats[i], v.x);
+    if (old + v.x < old) hi += 1u;
+  }
+  if (hi != 0u) atomicAdd(stats[i + 1u], hi);
 }
 
 uint resoct_read_node(uint index) {
@@ -221,7 +243,7 @@ void brick_insert(uint key) {
       i = (i + 1u) & (pc.brick_capacity - 1u);
     }
   }
-  stat_add(STAT_BRICK_DROPPED, 1u);
+  g_brick_dropped += 1u;
 }
 
 void node_insert(uint key) {
@@ -236,7 +258,7 @@ void node_insert(uint key) {
       i = (i + 1u) & (pc.node_capacity - 1u);
     }
   }
-  stat_add(STAT_NODE_DROPPED, 1u);
+  g_node_dropped += 1u;
 }
 
 void resoct_report_request(uint device_key) {
@@ -253,19 +275,65 @@ void resoct_mark_used(uint cache_slot) {
 
 #include "resoct/kernel/traverse.glsl.h"
 
+// One step of the tree reduction: lanes [0, s) add lanes [s, 2s) where those exist. Written out
+// per step rather than as a loop: lavapipe's loop guard (see main) could end a loop early in some
+// lanes, and a barrier inside a loop must be reached by every invocation the same number of
+// times. `WORKGROUP > s` is a specialization constant, so unused steps compile away.
+#define RESOCT_REDUCE_STEP(s)                                            \
+  if (WORKGROUP > (s)) {                                                 \
+    if (lid < (s) && lid + (s) < WORKGROUP) {                            \
+      [[unroll]] for (uint k = 0u; k < STAT_COUNT; ++k) {                \
+        partial[k][lid] = add64(partial[k][lid], partial[k][lid + (s)]); \
+      }                                                                  \
+    }                                                                    \
+    memoryBarrierShared();                                               \
+    barrier();                                                           \
+  }
+
 void main() {
   uvec2 px = gl_GlobalInvocationID.xy;
-  if (px.x >= frame.width || px.y >= frame.height) return;
-  ResoctRayStats st;
-  vec4 p = resoct_render_pixel(frame, px.x, px.y, st);
-  // The image holds straight alpha, as the CPU backend writes it.
-  pixels[px.y * frame.width + px.x] = p.a > 0.0 ? vec4(p.rgb / p.a, p.a) : vec4(0.0);
-  stat_add(STAT_SAMPLES, st.samples);
-  stat_add(STAT_NODES, st.nodes);
-  stat_add(STAT_ACCESSES, st.brick_accesses);
-  stat_add(STAT_ITERATIONS, st.iterations);
-  stat_add(STAT_CAPS, st.cap_hits);
-  stat_add(STAT_REQUESTS, st.requests);
-  stat_add(STAT_SKIPPED, uint(round(st.skipped * DISTANCE_SCALE)));
-  stat_add(STAT_MARCHED, uint(round(st.marched * DISTANCE_SCALE)));
+  uint counts[STAT_COUNT];
+  [[unroll]] for (uint k = 0u; k < STAT_COUNT; ++k) counts[k] = 0u;
+  // No early return: every invocation takes part in the reduction's barriers.
+  if (px.x < frame.width && px.y < frame.height) {
+    ResoctRayStats st;
+    vec4 p = resoct_render_pixel(frame, px.x, px.y, st);
+    // lavapipe ends every loop of an invocation once 65535 loop back-edges were taken in total
+    // (a driver guard against endless loops), which would cut a long ray short without a trace.
+    // This loop's trip count is unknown at compile time, so it stays a loop: it runs twice unless
+    // the guard has fired, and then the ray counts as stopped by the iteration cap.
+    uint canary = 0u;
+    for (uint i = 0u; i < 2u + (frame.width >> 31u); ++i) canary += 1u;
+    if (canary < 2u) st.cap_hits = 1u;
+    // The image holds straight alpha, as the CPU backend writes it.
+    pixels[px.y * frame.width + px.x] = p.a > 0.0 ? vec4(p.rgb / p.a, p.a) : vec4(0.0);
+    counts[STAT_SAMPLES] = st.samples;
+    counts[STAT_NODES] = st.nodes;
+    counts[STAT_ACCESSES] = st.brick_accesses;
+    counts[STAT_ITERATIONS] = st.iterations;
+    counts[STAT_CAPS] = st.cap_hits;
+    counts[STAT_REQUESTS] = st.requests;
+    counts[STAT_BRICK_DROPPED] = g_brick_dropped;
+    counts[STAT_NODE_DROPPED] = g_node_dropped;
+    counts[STAT_SKIPPED] = uint(round(st.skipped * DISTANCE_SCALE));
+    counts[STAT_MARCHED] = uint(round(st.marched * DISTANCE_SCALE));
+  }
+  uint lid = gl_LocalInvocationIndex;
+  [[unroll]] for (uint k = 0u; k < STAT_COUNT; ++k) partial[k][lid] = uvec2(counts[k], 0u);
+  memoryBarrierShared();
+  barrier();
+  // Workgroups of up to 1024 invocations (Vulkan's guaranteed maximum).
+  RESOCT_REDUCE_STEP(512u)
+  RESOCT_REDUCE_STEP(256u)
+  RESOCT_REDUCE_STEP(128u)
+  RESOCT_REDUCE_STEP(64u)
+  RESOCT_REDUCE_STEP(32u)
+  RESOCT_REDUCE_STEP(16u)
+  RESOCT_REDUCE_STEP(8u)
+  RESOCT_REDUCE_STEP(4u)
+  RESOCT_REDUCE_STEP(2u)
+  RESOCT_REDUCE_STEP(1u)
+  if (lid == 0u) {
+    [[unroll]] for (uint k = 0u; k < STAT_COUNT; ++k) stat_add64(k, partial[k][0]);
+  }
 }
