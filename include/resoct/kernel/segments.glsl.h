@@ -50,8 +50,11 @@ RESOCT_FN ResoctSegments resoct_segments_begin(ResoctFrame f, ivec3 origin_cell,
   uint n = min(f.slot_count, RESOCT_MAX_SLOTS);
   if (f.lens_enabled != 0u) {
     vec2 li = resoct_lens_interval(f, origin_cell, origin_frac, dir_vox);
-    sg.lens_in = li.x;
-    sg.lens_out = li.y;
+    // A miss leaves no stop: the ray is outside the lens throughout.
+    if (li.x < li.y) {
+      sg.lens_in = li.x;
+      sg.lens_out = li.y;
+    }
     sg.live_out = resoct_bank_live(n, n);
   }
   for (uint i = 0u; i < min(f.slice_count, RESOCT_MAX_SLICES); ++i) {
