@@ -18,22 +18,31 @@
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 
+// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
+#ifndef RESOCT_FRAME_IN
+#ifdef __cplusplus
+#define RESOCT_FRAME_IN const ResoctFrame&
+#else
+#define RESOCT_FRAME_IN ResoctFrame
+#endif
+#endif
+
 RESOCT_KERNEL_BEGIN
 
 /// Row i of the lens matrix.
-RESOCT_FN vec3 resoct_lens_row(ResoctFrame f, uint i) {
+RESOCT_FN vec3 resoct_lens_row(RESOCT_FRAME_IN f, uint i) {
   return vec3(f.lens_matrix[3u * i], f.lens_matrix[3u * i + 1u], f.lens_matrix[3u * i + 2u]);
 }
 
 /// Lens coordinates of a voxel-space vector.
-RESOCT_FN vec3 resoct_lens_apply(ResoctFrame f, vec3 v) {
+RESOCT_FN vec3 resoct_lens_apply(RESOCT_FRAME_IN f, vec3 v) {
   return vec3(dot(resoct_lens_row(f, 0u), v), dot(resoct_lens_row(f, 1u), v),
               dot(resoct_lens_row(f, 2u), v));
 }
 
 /// (t_in, t_out) of the ray origin_cell + origin_frac + t * dir_vox with the lens box; empty
 /// (t_in >= t_out) when it misses.
-RESOCT_FN vec2 resoct_lens_interval(ResoctFrame f, ivec3 origin_cell, vec3 origin_frac,
+RESOCT_FN vec2 resoct_lens_interval(RESOCT_FRAME_IN f, ivec3 origin_cell, vec3 origin_frac,
                                     vec3 dir_vox) {
   ivec3 lens_cell = ivec3(f.lens_cell_x, f.lens_cell_y, f.lens_cell_z);
   vec3 rel = vec3(origin_cell - lens_cell) +

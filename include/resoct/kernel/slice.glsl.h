@@ -27,18 +27,27 @@
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
+// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
+#ifndef RESOCT_FRAME_IN
+#ifdef __cplusplus
+#define RESOCT_FRAME_IN const ResoctFrame&
+#else
+#define RESOCT_FRAME_IN ResoctFrame
+#endif
+#endif
+
 RESOCT_KERNEL_BEGIN
 
 /// Largest footprint stretch 1 / |cos θ| of a grazing plane (beyond it the plane is edge-on).
 RESOCT_CONST(float, RESOCT_SLICE_MAX_STRETCH, 64.0f);
 
-RESOCT_FN vec3 resoct_slice_normal(ResoctFrame f, uint i) {
+RESOCT_FN vec3 resoct_slice_normal(RESOCT_FRAME_IN f, uint i) {
   return vec3(f.slice_normal[3u * i], f.slice_normal[3u * i + 1u], f.slice_normal[3u * i + 2u]);
 }
 
 /// Parameter at which the ray origin_cell + origin_frac + t * dir_vox meets plane i;
 /// RESOCT_RAY_T_INF when it runs parallel to it.
-RESOCT_FN float resoct_slice_hit(ResoctFrame f, uint i, ivec3 origin_cell, vec3 origin_frac,
+RESOCT_FN float resoct_slice_hit(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, vec3 origin_frac,
                                  vec3 dir_vox) {
   vec3 n = resoct_slice_normal(f, i);
   ivec3 cell = ivec3(f.slice_cell[3u * i], f.slice_cell[3u * i + 1u], f.slice_cell[3u * i + 2u]);
@@ -52,7 +61,7 @@ RESOCT_FN float resoct_slice_hit(ResoctFrame f, uint i, ivec3 origin_cell, vec3 
 
 /// Level of detail on plane i at parameter t: the view-depth footprint stretched by the plane's
 /// obliquity.
-RESOCT_FN uint resoct_slice_lod(ResoctFrame f, uint i, vec3 dir_box, float t) {
+RESOCT_FN uint resoct_slice_lod(RESOCT_FRAME_IN f, uint i, vec3 dir_box, float t) {
   vec3 nb = normalize(resoct_slice_normal(f, i) * resoct_frame_voxels_per_box(f));
   float cosine = abs(dot(nb, dir_box));
   float stretch = 1.0f / max(cosine, 1.0f / RESOCT_SLICE_MAX_STRETCH);
@@ -105,7 +114,7 @@ RESOCT_FN bool resoct_slice_channel(ResoctSampleParams p, ResoctSlotInfo s, uint
 }
 
 /// Premultiplied colour of plane i where the ray meets it at t (inside the volume).
-RESOCT_FN vec4 resoct_slice_shade(ResoctFrame f, uint i, ivec3 origin_cell, vec3 origin_frac,
+RESOCT_FN vec4 resoct_slice_shade(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, vec3 origin_frac,
                                   vec3 dir_box, vec3 dir_vox, float t,
                                   RESOCT_INOUT(ResoctRayStats) st) {
   ivec3 cell;

@@ -212,11 +212,15 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   // between host and device division and would make the backends' sample counts disagree.
   // Slices and lens (kernel/segments.glsl.h): t_exit is the end of the current segment; at it,
   // resoct_segment_next composites slices and opens the next segment (bank, live channels).
-  ResoctSegments segs = resoct_segments_begin(f, o_cell, o_frac, dir_vox, t, t_exit, live);
-  if (segs.enabled != 0u) t_exit = t;
+  ResoctSegments segs = resoct_segments_none(live);
+  if (f.slice_count != 0u || f.lens_enabled != 0u) {
+    resoct_segments_begin(f, segs, o_cell, o_frac, dir_vox, t, t_exit);
+    t_exit = t;
+  }
   while (t_exit - t > RESOCT_SEGMENT_EPS * dt ||
-         resoct_segment_next(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc, live,
-                             cached_node, cached_coord, stats)) {
+         (segs.enabled != 0u &&
+          resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc,
+                                 live, cached_node, cached_coord, stats))) {
     if (stats.iterations >= f.max_iterations) {
       stats.cap_hits = 1u;
       break;
