@@ -93,8 +93,9 @@ double g_plain_ms = 0.0;
 
 void BM_SliceLensFrame(benchmark::State& state) {
   static std::unique_ptr<Rig> rig;
-  if (!rig) rig = std::make_unique<Rig>(tubes(frame_extent()), std::vector<std::uint32_t>{0},
-                                        glm::uvec3(32), glm::uvec3(16));
+  if (!rig)
+    rig = std::make_unique<Rig>(tubes(frame_extent()), std::vector<std::uint32_t>{0},
+                                glm::uvec3(32), glm::uvec3(16));
   const int v = int(state.range(0));
   const Scene scene = variant_scene(*rig, v);
   const std::vector<FrameTables> tables =
@@ -123,6 +124,8 @@ void BM_LensPaging(benchmark::State& state) {
     o.backend_options.threads = 1;
     o.loader_threads = 0;
     o.strategy = RequestStrategy::global;
+    o.device_cache_bytes = std::uint64_t(64) << 20;
+    o.host_cache_bytes = std::uint64_t(256) << 20;
     Renderer renderer(source, o);
     Scene s;
     s.camera = orbit_camera(source->hierarchy().volume(), 0.3);
