@@ -158,7 +158,8 @@ RESOCT_FN bool resoct_segment_advance(RESOCT_FRAME_IN f, RESOCT_INOUT(ResoctSegm
                                       ivec3 origin_cell, vec3 origin_frac, vec3 dir_box,
                                       vec3 dir_vox, float dt, RESOCT_INOUT(float) t,
                                       RESOCT_INOUT(float) t_exit, RESOCT_INOUT(vec4) acc,
-                                      RESOCT_INOUT(uint) live, RESOCT_INOUT(uint) cached_node,
+                                      RESOCT_INOUT(uint) live, RESOCT_INOUT(uint) bank,
+                                      RESOCT_INOUT(uint) cached_node,
                                       RESOCT_INOUT(uvec3) cached_coord,
                                       RESOCT_INOUT(ResoctRayStats) st) {
   sg.t = t;
@@ -170,6 +171,7 @@ RESOCT_FN bool resoct_segment_advance(RESOCT_FRAME_IN f, RESOCT_INOUT(ResoctSegm
   t = sg.t;
   t_exit = sg.stop;
   live = sg.live;
+  bank = sg.bank;
   if (sg.reset != 0u) {
     // The residency mode's node classification depends on the bank's channels.
     cached_node = 0xFFFFFFFFu;

@@ -5,13 +5,14 @@
 // the plane's pixel footprint picks the level: the view-depth footprint divided by |cos θ|
 // between ray and plane normal (an oblique plane stretches a pixel over more voxels; the factor
 // is capped at RESOCT_SLICE_MAX_STRETCH), against the same per-level size table as the volume.
-// Each shown channel takes its target level when present, else requests it (with the frame's
-// request strategy) and substitutes the nearest present level of its range, coarser first, then
-// finer. An EMPTY brick is all zero, so on a slice it shows value 0. With window/level the
-// channel is the opaque grey clamp((v - level) / window + 1/2, 0, 1), else the transfer
-// function's colour and alpha as they are (a plane has no thickness to correct for). Channels
-// are intermixed like volume samples (composite.glsl.h) and the result composited at t: what
-// lies in front covers the slice, the slice covers what lies behind.
+// Each shown channel goes through the volume's residency-mode step (channel_sample.glsl.h): its
+// target level when present, else a request (with the frame's strategy) and the nearest level
+// partially resident in the finest octree node at the point, coarser first, then finer. An EMPTY
+// brick is all zero, so on a slice it shows value 0. With window/level the channel is the opaque
+// grey clamp((v - level) / window + 1/2, 0, 1), else the transfer function's colour and alpha as
+// they are (a plane has no thickness to correct for). Channels are intermixed like volume samples
+// (composite.glsl.h) and the result composited at t: what lies in front covers the slice, the slice
+// covers what lies behind.
 //
 // Accessors: as listed in traverse.glsl.h.
 #ifndef RESOCT_KERNEL_SLICE_GLSL_H
@@ -71,46 +72,46 @@ RESOCT_FN uint resoct_slice_lod(RESOCT_FRAME_IN f, uint i, vec3 dir_box, float t
   return resoct_lod_level(budget, f.level_count);
 }
 
-/// Value of a present page entry on a slice: EMPTY is value 0.
-RESOCT_FN bool resoct_slice_entry(ResoctSlotInfo s, uint entry, ResoctLevelInfo L, uvec3 bs,
-                                  uint halo, uvec3 brick, ivec3 cell, vec3 frac,
-                                  RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
-  return resoct_entry_value(s, entry, L, bs, halo, brick, cell, frac, value, st) != RESOCT_CH_NONE;
+/// One channel on a slice, through the volume path's own per-channel step
+/// (resoct_residency_channel): the target level if present, else request it and substitute the
+/// nearest level partially resident in the finest octree node at the point (coarser first, then
+/// finer), each candidate checked by its page entry. False when nothing is present. EMPTY is
+/// value 0 here (an EMPTY brick is all zero).
+RESOCT_FN bool resoct_slice_channel(ResoctSampleParams p, ResoctSlotInfo s, uint node, uint target,
+                                    ivec3 cell, vec3 frac, RESOCT_INOUT(uint) last_key,
+                                    RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
+  uint res = resoct_residency_channel(p, s, node, target, cell, frac, last_key, value, st);
+  if (res == RESOCT_CH_EMPTY) value = 0.0f;
+  return res != RESOCT_CH_NONE;
 }
 
-/// One channel on a slice: the target level if present, else request it and substitute the
-/// nearest present level in [finest, coarsest], coarser first. False when none is present.
-RESOCT_FN bool resoct_slice_channel(ResoctSampleParams p, ResoctSlotInfo s, uint target, ivec3 cell,
-                                    vec3 frac, RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
-                                    RESOCT_INOUT(ResoctRayStats) st) {
-  value = 0.0f;
-  uvec3 bs = resoct_frame_brick_size(p);
-  ResoctLevelInfo L = resoct_read_level(target);
-  uvec3 b = resoct_brick_at(L, bs, cell);
-  uint e = resoct_page_entry_of(s.slot, target, p.level_count, L, b);
-  if (resoct_page_state(e) != RESOCT_PAGE_STATE_UNMAPPED) {
-    return resoct_slice_entry(s, e, L, bs, p.halo, b, cell, frac, value, st);
-  }
-  resoct_request_missing(p, s, target, cell, last_key, st);
-  for (uint l = target + 1u; l <= s.coarsest_level; ++l) {
-    ResoctLevelInfo Lc = resoct_read_level(l);
-    uvec3 bc = resoct_brick_at(Lc, bs, cell);
-    uint ec = resoct_page_entry_of(s.slot, l, p.level_count, Lc, bc);
-    if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_slice_entry(s, ec, Lc, bs, p.halo, bc, cell, frac, value, st);
+/// Flat index of the finest octree node containing a cell inside the volume.
+RESOCT_FN uint resoct_slice_node(RESOCT_FRAME_IN f, ivec3 cell) {
+  uint depth = f.depth_count - 1u;
+  ResoctDepthInfo D = resoct_read_depth(depth);
+  uvec3 c = min(uvec3(cell) / uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z),
+                uvec3(D.count_x - 1u, D.count_y - 1u, D.count_z - 1u));
+  uvec3 c_log2 =
+      uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
+  uint local = 0u;
+  for (uint d = 1u; d <= depth; ++d) {
+    ResoctDepthInfo Dd = resoct_read_depth(d);
+    uvec3 a = c >> (c_log2 - uvec3(uint(findMSB(Dd.count_x)), uint(findMSB(Dd.count_y)),
+                                   uint(findMSB(Dd.count_z))));
+    uint bits = 0u;
+    uint shift = 0u;
+    if (Dd.split_x != 0u) {
+      bits = a.x & 1u;
+      shift = 1u;
     }
-  }
-  uint l = target;
-  while (l > s.finest_level) {
-    l = l - 1u;
-    ResoctLevelInfo Lf = resoct_read_level(l);
-    uvec3 bf = resoct_brick_at(Lf, bs, cell);
-    uint ef = resoct_page_entry_of(s.slot, l, p.level_count, Lf, bf);
-    if (resoct_page_state(ef) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_slice_entry(s, ef, Lf, bs, p.halo, bf, cell, frac, value, st);
+    if (Dd.split_y != 0u) {
+      bits = bits | ((a.y & 1u) << shift);
+      shift = shift + 1u;
     }
+    if (Dd.split_z != 0u) bits = bits | ((a.z & 1u) << shift);
+    local = (local << Dd.child_shift) | bits;
   }
-  return false;
+  return D.first_node + local;
 }
 
 /// Premultiplied colour of plane i where the ray meets it at t (inside the volume).
@@ -123,6 +124,7 @@ RESOCT_FN vec4 resoct_slice_shade(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, 
   resoct_clamp_position(f, cell, frac);
   uint lod = resoct_slice_lod(f, i, dir_box, t);
   ResoctSampleParams p = resoct_sample_params(f);
+  uint node = resoct_slice_node(f, cell);
   vec4 weighted;
   float combined;
   resoct_mix_begin(weighted, combined);
@@ -135,7 +137,7 @@ RESOCT_FN vec4 resoct_slice_shade(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, 
     uint last_key = RESOCT_REQUEST_KEY_NONE;
     float value;
     uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-    if (!resoct_slice_channel(p, s, target, cell, frac, last_key, value, st)) continue;
+    if (!resoct_slice_channel(p, s, node, target, cell, frac, last_key, value, st)) continue;
     any_value = true;
     if (f.slice_window[i] > 0.0f) {
       float g = clamp((value - f.slice_level[i]) / f.slice_window[i] + 0.5f, 0.0f, 1.0f);
