@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "cpu_test_util.hpp"
+#include "support/expect_error.hpp"
 #include "resoct/camera.hpp"
 #include "resoct/renderer.hpp"
 
@@ -216,6 +217,50 @@ TEST(CpuLens, OutsideRendersTheCoarserRange) {
     }
   }
   EXPECT_EQ(levels, (std::set<std::uint32_t>{0u, 2u}));
+}
+
+// The outside bank follows the slot table entry by entry: hidden channels are never visible,
+// the level range is clamped to the hierarchy; a table whose size does not match is rejected.
+TEST(CpuLens, FrameTablesHoldTheOutsideBank) {
+  ProceduralSource src("procedural:ramp:32x32x32:3", bricks(8));
+  ResidentScene rs(src, {0, 1, 2});
+  Scene s = make_scene(8, perspective());
+  s.channels = {make_channel(0, kVisible), make_channel(1, kVisible), make_channel(2, kVisible)};
+  s.channels[2].importance = -1;  // slot-table entry 0
+  Lens lens;
+  LensOutside hide1;
+  hide1.channel = 1;
+  LensOutside coarse2;
+  coarse2.channel = 2;
+  coarse2.hide = false;
+  coarse2.finest_level = 1;
+  coarse2.coarsest_level = 20;
+  lens.outside = {hide1, coarse2};  // channel 0 unlisted: hidden
+  s.lens = lens;
+  FrameTables t = rs.tables(s);
+  ASSERT_EQ(t.frame.lens_enabled, 1u);
+  ASSERT_EQ(t.slots.size(), 6u);
+  const std::uint32_t last = src.hierarchy().level_count() - 1u;
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const kernel::ResoctSlotInfo& in = t.slots[k];
+    const kernel::ResoctSlotInfo& out = t.slots[3 + k];
+    EXPECT_EQ(out.slot, in.slot);
+    if (in.slot == 2u) {
+      EXPECT_EQ(out.vis_bins, in.vis_bins);
+      EXPECT_EQ(out.finest_level, 1u);
+      EXPECT_EQ(out.coarsest_level, last);
+    } else {
+      EXPECT_EQ(out.vis_bins, 0u);
+      EXPECT_GT(out.vis_lo16, out.vis_hi16);
+    }
+  }
+  EXPECT_EQ(t.slots[0].slot, 2u);
+  cpu::CpuBackend backend(1);
+  rs.upload(backend);
+  t.slots.pop_back();
+  FrameResult r;
+  EXPECT_RESOCT_ERROR(backend.render(t, r), ErrorCode::invalid_argument,
+                      "slot table size differs from slot_count");
 }
 
 // A lens roaming a 65536^3 volume (bricks of 256^3, 12 levels): with everything hidden outside,

@@ -211,7 +211,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs
   // between host and device division and would make the backends' sample counts disagree.
   // Slices and lens (kernel/segments.glsl.h): t_exit is the end of the current segment; at it,
-  // resoct_segment_next composites slices and opens the next segment (bank, live channels).
+  // resoct_segment_advance composites slices and opens the next segment (bank, live channels).
   ResoctSegments segs = resoct_segments_none(live);
   uint bank = 0u;  // slot-table bank of the current segment
   if (f.slice_count != 0u || f.lens_enabled != 0u) {
