@@ -125,5 +125,37 @@ TEST(VulkanSlices, PartlyResidentGivesTheSameRequests) {
   run_cases("procedural:tubes:48x48x48", o, RequestStrategy::greedy, "partial");
 }
 
+// The shipped example scene (two slices and a lens with a coarser outside) as resoct-render
+// renders it (tubes 64³, leaves 16³), with the lens and slices removed one at a time, and the
+// plain scene as the control. At 64² pixels the plain scene itself (no slice, no lens) already
+// differs by one iteration on one ray between lavapipe and the CPU (samples identical), a
+// discrepancy of the volume march outside this work; 48² avoids that ray.
+TEST(VulkanSlices, ShippedSlicesSceneMatchesTheCpuBackend) {
+  auto gpu = make_validated_vulkan();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  ProceduralSource src("procedural:tubes:64x64x64", small_bricks());
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(16);
+  ResidentScene rs(src, {0}, ro);
+  Scene s = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/slices.json");
+  s.viewport = {48, 48};
+  cpu::CpuBackend cpu(1);
+  OracleDiff d;
+  FrameOptions o;
+  o.start_depth = 2;
+  expect_same_frame(render_on(cpu, rs, s, o), render_on(*gpu, rs, s, o), "slices.json", d);
+  Scene no_lens = s;
+  no_lens.lens.reset();
+  expect_same_frame(render_on(cpu, rs, no_lens, o), render_on(*gpu, rs, no_lens, o), "no lens", d);
+  Scene no_slices = s;
+  no_slices.slices.clear();
+  expect_same_frame(render_on(cpu, rs, no_slices, o), render_on(*gpu, rs, no_slices, o),
+                    "no slices", d);
+  Scene plain = no_slices;
+  plain.lens.reset();
+  expect_same_frame(render_on(cpu, rs, plain, o), render_on(*gpu, rs, plain, o), "plain", d);
+  expect_no_validation_messages(*gpu);
+}
+
 }  // namespace
 }  // namespace resoct::test

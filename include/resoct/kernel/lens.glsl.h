@@ -18,6 +18,17 @@
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 
+// Results that decide where segments start and end: `precise` in GLSL so that the device does not
+// contract them into fused multiply-adds (the CPU build never does), keeping segment boundaries,
+// and hence iteration counts, identical between backends.
+#ifndef RESOCT_PRECISE
+#ifdef __cplusplus
+#define RESOCT_PRECISE
+#else
+#define RESOCT_PRECISE precise
+#endif
+#endif
+
 // Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
 #ifndef RESOCT_FRAME_IN
 #ifdef __cplusplus
@@ -36,8 +47,9 @@ RESOCT_FN vec3 resoct_lens_row(RESOCT_FRAME_IN f, uint i) {
 
 /// Lens coordinates of a voxel-space vector.
 RESOCT_FN vec3 resoct_lens_apply(RESOCT_FRAME_IN f, vec3 v) {
-  return vec3(dot(resoct_lens_row(f, 0u), v), dot(resoct_lens_row(f, 1u), v),
-              dot(resoct_lens_row(f, 2u), v));
+  RESOCT_PRECISE vec3 r = vec3(dot(resoct_lens_row(f, 0u), v), dot(resoct_lens_row(f, 1u), v),
+                               dot(resoct_lens_row(f, 2u), v));
+  return r;
 }
 
 /// (t_in, t_out) of the ray origin_cell + origin_frac + t * dir_vox with the lens box; empty
@@ -45,8 +57,8 @@ RESOCT_FN vec3 resoct_lens_apply(RESOCT_FRAME_IN f, vec3 v) {
 RESOCT_FN vec2 resoct_lens_interval(RESOCT_FRAME_IN f, ivec3 origin_cell, vec3 origin_frac,
                                     vec3 dir_vox) {
   ivec3 lens_cell = ivec3(f.lens_cell_x, f.lens_cell_y, f.lens_cell_z);
-  vec3 rel = vec3(origin_cell - lens_cell) +
-             (origin_frac - vec3(f.lens_frac_x, f.lens_frac_y, f.lens_frac_z));
+  RESOCT_PRECISE vec3 rel = vec3(origin_cell - lens_cell) +
+                            (origin_frac - vec3(f.lens_frac_x, f.lens_frac_y, f.lens_frac_z));
   return resoct_ray_box(resoct_lens_apply(f, rel), resoct_lens_apply(f, dir_vox), vec3(-1.0f),
                         vec3(1.0f));
 }

@@ -28,6 +28,15 @@
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
+// `precise` in GLSL for the plane hit, which decides segment boundaries (see lens.glsl.h).
+#ifndef RESOCT_PRECISE
+#ifdef __cplusplus
+#define RESOCT_PRECISE
+#else
+#define RESOCT_PRECISE precise
+#endif
+#endif
+
 // Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
 #ifndef RESOCT_FRAME_IN
 #ifdef __cplusplus
@@ -55,9 +64,10 @@ RESOCT_FN float resoct_slice_hit(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, v
   vec3 rel = vec3(cell - origin_cell) +
              (vec3(f.slice_frac[3u * i], f.slice_frac[3u * i + 1u], f.slice_frac[3u * i + 2u]) -
               origin_frac);
-  float denom = dot(n, dir_vox);
+  RESOCT_PRECISE float denom = dot(n, dir_vox);
   if (abs(denom) < RESOCT_RAY_PARALLEL_EPS) return RESOCT_RAY_T_INF;
-  return dot(n, rel) / denom;
+  RESOCT_PRECISE float th = dot(n, rel) / denom;
+  return th;
 }
 
 /// Level of detail on plane i at parameter t: the view-depth footprint stretched by the plane's
