@@ -5,6 +5,7 @@
 /// to JSON (docs/scene.md).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <glm/vec4.hpp>
 
 #include "resoct/camera.hpp"
+#include "resoct/scene_slices.hpp"
 #include "resoct/transfer_function.hpp"
 #include "resoct/volume_desc.hpp"
 
@@ -46,6 +48,9 @@ struct Scene {
   double ert_opacity = 0.99;  ///< early termination opacity, in (0, 1]
   glm::dvec4 background{0.0, 0.0, 0.0, 1.0};  ///< straight-alpha RGBA, each in [0, 1]
   std::vector<Effect> effects;
+  // Slices and lens (docs/scene.md "Slices and lens").
+  std::vector<SlicePlane> slices;  ///< at most kMaxSlices planes
+  std::optional<Lens> lens;        ///< none: every channel everywhere
 
   /// Throws Error(invalid_argument) "<what>: <field>: why" when a field is out of range (the
   /// same checks as loading), `what` e.g. a file name.

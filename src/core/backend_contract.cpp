@@ -10,9 +10,12 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
   const kernel::ResoctFrame& f = t.frame;
   auto fail = [](const std::string& why) { throw invalid_parameter("tables", why); };
   if (f.width == 0 || f.height == 0) fail("empty image");
-  if (t.slots.size() != f.slot_count || f.slot_count > kernel::RESOCT_MAX_SLOTS) {
+  // A lens adds a second bank of slot entries (outside the lens) after the first.
+  if (f.lens_enabled > 1u || t.slots.size() != std::size_t(f.slot_count) * (1u + f.lens_enabled) ||
+      f.slot_count > kernel::RESOCT_MAX_SLOTS) {
     fail("slot table size differs from slot_count");
   }
+  if (f.slice_count > kernel::RESOCT_MAX_SLICES) fail("slice_count above RESOCT_MAX_SLICES");
   if (t.levels.size() != f.level_count || f.level_count == 0 || f.level_count > 32) {
     fail("level table size differs from level_count");
   }

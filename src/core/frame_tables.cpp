@@ -8,6 +8,7 @@
 #include "resoct/camera.hpp"
 #include "resoct/error.hpp"
 #include "resoct/residency_octree.hpp"
+#include "frame_tables_slices.hpp"
 
 namespace resoct {
 
@@ -185,6 +186,7 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   f.background_g = float(scene.background.g);
   f.background_b = float(scene.background.b);
   f.background_a = float(scene.background.a);
+  detail::fill_slices_and_lens(scene, hierarchy, channels, out);
 
   const std::vector<float> sizes = level_size_log2_table(hierarchy);
   out.levels.clear();

@@ -9,6 +9,7 @@
 
 #include "resoct/file_io.hpp"
 #include "resoct/error.hpp"
+#include "scene_slices.hpp"
 
 namespace resoct {
 namespace {
@@ -254,6 +255,7 @@ void check_scene(const Scene& s, const std::string& what) {
       }
     }
   }
+  detail::check_slices_and_lens(s, what);
 }
 
 json vec_json(const double* v, int n) {
@@ -295,7 +297,7 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   if (!doc.is_object()) r.fail("(root)", "must be an object");
   r.only_keys(doc, "",
               {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity",
-               "background", "effects"});
+               "background", "effects", "slices", "lens"});
   Scene s;
   s.camera = read_camera(r, r.require(doc, "", "camera"));
   if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
@@ -321,6 +323,7 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
       }
     }
   }
+  detail::read_slices_and_lens(doc, name, s);
   check_scene(s, name);
   return s;
 }
@@ -365,6 +368,7 @@ std::string scene_to_json(const Scene& s) {
   json effects = json::array();
   for (Effect e : s.effects) effects.push_back(to_string(e));
   doc["effects"] = effects;
+  detail::slices_and_lens_to_json(s, doc);
   return doc.dump(2) + "\n";
 }
 

@@ -80,6 +80,25 @@ TEST(RenderTool, RendersAStoreWrittenByConvert) {
   EXPECT_EQ(resoct::read_png(png).width(), 40u);
 }
 
+// examples/scenes/slices.json: a window/level slice at z = 0.3 faces the camera; the voxels
+// there are mostly 0, which the window shows as grey 0.3 (opaque), unlike the bluish background.
+TEST(RenderTool, RendersSlicesAndLens) {
+  TempDir dir;
+  const std::string png = dir.file("slices.png"), stats = dir.file("slices.json");
+  const ToolRun r = run(dir, RESOCT_RENDER,
+                        render_args("procedural:tubes:64x64x64", scene("slices"), png, stats));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+  EXPECT_TRUE(j["converged"].get<bool>());
+  EXPECT_EQ(j["cap_hits"].get<std::uint64_t>(), 0u);
+  const resoct::Image img = resoct::read_png(png);
+  std::uint32_t grey = 0;
+  for (const glm::vec4& p : img.pixels()) {
+    if (std::abs(p.r - 0.3f) < 0.01f && p.r == p.g && p.g == p.b) ++grey;
+  }
+  EXPECT_GT(grey, 40u);
+}
+
 TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
   TempDir dir;
   const std::string png = dir.file("x.png"), stats = dir.file("x.json");

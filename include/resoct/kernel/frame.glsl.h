@@ -29,6 +29,8 @@ RESOCT_CONST(uint, RESOCT_PROJECTION_ORTHOGRAPHIC, 1u);
 
 // Most visible slots one frame may hold (bounds per-ray arrays in the kernel).
 RESOCT_CONST(uint, RESOCT_MAX_SLOTS, 32u);
+// Most slice planes one frame may hold (kernel/slice.glsl.h).
+RESOCT_CONST(uint, RESOCT_MAX_SLICES, 4u);
 
 // Per-frame constants.
 struct ResoctFrame {
@@ -106,6 +108,26 @@ struct ResoctFrame {
   // 1 = greedy (the target and every coarser level's brick at the sample position up to the
   // first one that is present or the channel's coarsest level). Added by the traversal kernel.
   uint request_greedy;
+
+  // Slices and lens (kernel/slice.glsl.h, kernel/lens.glsl.h), all zero when the scene has none.
+  // Positions are split like the eye (exact level-0 cell + fraction); vectors are in voxel space.
+  uint slice_count;                            // planes in use, <= RESOCT_MAX_SLICES
+  uint lens_enabled;                           // 1: the slot table holds a second bank
+  int slice_cell[3u * RESOCT_MAX_SLICES];      // point on plane i: cell (x, y, z) at 3i
+  float slice_frac[3u * RESOCT_MAX_SLICES];    //   and fraction in [0, 1)
+  float slice_normal[3u * RESOCT_MAX_SLICES];  // unit plane normal in voxel space
+  float slice_window[RESOCT_MAX_SLICES];       // > 0: window/level grey; 0: transfer function
+  float slice_level[RESOCT_MAX_SLICES];        // normalized value shown as grey 1/2
+  uint slice_channels[RESOCT_MAX_SLICES];      // bit c: slot-table entry c is shown
+  int lens_cell_x;                             // lens centre: cell and fraction
+  int lens_cell_y;
+  int lens_cell_z;
+  float lens_frac_x;
+  float lens_frac_y;
+  float lens_frac_z;
+  // Row i (at 3i): lens axis i / (voxels_per_box * half size i), so that a voxel-space offset
+  // from the centre maps to lens coordinates, the lens being [-1, 1]^3.
+  float lens_matrix[9];
 };
 
 // One visible channel, in importance order (slot table index 0 is traversed first).

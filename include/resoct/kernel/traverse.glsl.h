@@ -38,6 +38,7 @@
 #include "resoct/kernel/ray.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 #include "resoct/kernel/sample.glsl.h"
+#include "resoct/kernel/segments.glsl.h"
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
@@ -172,7 +173,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   for (uint i = 0u; i < n; ++i) {
     if (resoct_read_slot(i).vis_bins != 0u) live = live | (1u << i);
   }
-  if (live == 0u) return resoct_over_background(acc, background);
+  if (live == 0u && f.slice_count == 0u) return resoct_over_background(acc, background);
 
   vec3 dir_box;
   ivec3 o_cell;
@@ -209,7 +210,18 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
   // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs
   // between host and device division and would make the backends' sample counts disagree.
-  while (t_exit - t > RESOCT_SEGMENT_EPS * dt) {
+  // Slices and lens (kernel/segments.glsl.h): t_exit is the end of the current segment; at it,
+  // resoct_segment_advance composites slices and opens the next segment (bank, live channels).
+  ResoctSegments segs = resoct_segments_none(live);
+  uint bank = 0u;  // slot-table bank of the current segment
+  if (f.slice_count != 0u || f.lens_enabled != 0u) {
+    resoct_segments_begin(f, segs, o_cell, o_frac, dir_vox, t, t_exit);
+    t_exit = t;
+  }
+  while (t_exit - t > RESOCT_SEGMENT_EPS * dt ||
+         (segs.enabled != 0u &&
+          resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc,
+                                 live, bank, cached_node, cached_coord, stats))) {
     if (stats.iterations >= f.max_iterations) {
       stats.cap_hits = 1u;
       break;
@@ -260,7 +272,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           while (ci < n) {
             bool empty = ((live >> ci) & 1u) == 0u ||
                          resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
-                                                   resoct_read_slot(ci),
+                                                   resoct_read_slot(bank + ci),
                                                    f.node_slot_count) == RESOCT_NODE_CLASS_EMPTY;
             if (!empty) break;
             cached_empty = cached_empty | (1u << ci);
@@ -281,7 +293,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
               cached_empty = cached_empty | (1u << c);
               continue;
             }
-            ResoctSlotInfo sc = resoct_read_slot(c);
+            ResoctSlotInfo sc = resoct_read_slot(bank + c);
             uint cls = resoct_node_class(node, sc, f.node_slot_count);
             if (cls == RESOCT_NODE_CLASS_INVALID) {
               invalid = true;
@@ -311,7 +323,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
       } else {
         for (uint c = 0u; c < n; ++c) {
           if (((cached_empty >> c) & 1u) != 0u) continue;
-          ResoctSlotInfo s = resoct_read_slot(c);
+          ResoctSlotInfo s = resoct_read_slot(bank + c);
           float value = 0.0f;
           uint res = RESOCT_CH_NONE;
           if (((cached_homog >> c) & 1u) != 0u) {
@@ -338,7 +350,7 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
       bool all_empty = true;
       for (uint c = 0u; c < n; ++c) {
         if (((live >> c) & 1u) == 0u) continue;
-        ResoctSlotInfo s = resoct_read_slot(c);
+        ResoctSlotInfo s = resoct_read_slot(bank + c);
         uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
         float value = 0.0f;
         float exit_c = 0.0f;
