@@ -86,11 +86,11 @@ void BM_Table1(benchmark::State& state) {
     const auto pt = done.find({dataset, channels, int(RenderMode::pagetable)});
     const auto oct = done.find({dataset, channels, int(RenderMode::octree)});
     if (pt != done.end()) {
-      state.counters["res_over_pt"] = a.ms_frame / pt->second.ms_frame;
+      state.counters["res_over_pt"] = a.ratio_ms() / pt->second.ratio_ms();
       state.counters["ws_res_over_pt"] = a.working_set_bytes / pt->second.working_set_bytes;
     }
     if (oct != done.end()) {
-      state.counters["res_over_oct"] = a.ms_frame / oct->second.ms_frame;
+      state.counters["res_over_oct"] = a.ratio_ms() / oct->second.ratio_ms();
       state.counters["ws_res_over_oct"] = a.working_set_bytes / oct->second.working_set_bytes;
     }
   }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <numbers>
 #include <string_view>
 
@@ -23,6 +24,12 @@ namespace resoct::bench {
 namespace {
 Preset g_preset = Preset::standard;
 std::string g_backend = "cpu";
+
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
 
 bool env_set(const char* name) {
   const char* v = std::getenv(name);
@@ -169,6 +176,10 @@ std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, Render
   return out;
 }
 
+double FrameAverages::ratio_ms() const {
+  return backend_name() == "cpu" && cpu_ms_frame > 0 ? cpu_ms_frame : ms_frame;
+}
+
 FrameAverages run_frames(benchmark::State& state, Rig& rig,
                          const std::vector<FrameTables>& tables) {
   FrameResult result;
@@ -177,10 +188,13 @@ FrameAverages run_frames(benchmark::State& state, Rig& rig,
   if (!tables.empty()) rig.backend->render(tables.front(), result);
   BackendStats total;
   double slots = 0;
+  double cpu_ms = 0;
   std::int64_t frames = 0;
   for (auto _ : state) {
     for (const FrameTables& t : tables) {
+      const double cpu0 = thread_cpu_ms();
       rig.backend->render(t, result);
+      cpu_ms += thread_cpu_ms() - cpu0;
       benchmark::DoNotOptimize(result.image.pixels().data());
       benchmark::ClobberMemory();
       total.rays += result.stats.rays;
@@ -198,6 +212,7 @@ FrameAverages run_frames(benchmark::State& state, Rig& rig,
   const double rays = double(total.rays);
   a.ms_frame = total.ms_render / f;
   a.ms_device = total.ms_device / f;
+  a.cpu_ms_frame = cpu_ms / f;
   a.bricks_touched = slots / f;
   a.working_set_bytes = a.bricks_touched * double(rig.brick_bytes);
   a.samples_per_ray = double(total.samples) / rays;
@@ -205,6 +220,7 @@ FrameAverages run_frames(benchmark::State& state, Rig& rig,
   a.brick_accesses_per_ray = double(total.brick_accesses) / rays;
   state.counters["ms_frame"] = a.ms_frame;
   if (a.ms_device > 0) state.counters["ms_device"] = a.ms_device;
+  state.counters["cpu_ms_frame"] = a.cpu_ms_frame;
   state.counters["working_set_MiB"] = a.working_set_bytes / double(1 << 20);
   state.counters["samples_per_ray"] = a.samples_per_ray;
   state.counters["nodes_per_ray"] = a.nodes_per_ray;

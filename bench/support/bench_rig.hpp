@@ -85,8 +85,9 @@ struct FrameAverages {
 };
 
 /// Renders all tables (one orbit) per benchmark iteration and returns per-frame averages; sets
-/// the counters ms_frame (host wall time of Backend::render), ms_device (device timestamps;
-/// Vulkan only), working_set_MiB, samples_per_ray, nodes_per_ray, bricks_touched.
+/// the counters ms_frame (host wall time of Backend::render), cpu_ms_frame (CPU time of the
+/// calling thread in Backend::render), ms_device (device timestamps; Vulkan only), working_set_MiB,
+/// samples_per_ray, nodes_per_ray, bricks_touched.
 FrameAverages run_frames(benchmark::State& state, Rig& rig, const std::vector<FrameTables>& tables);
 
 }  // namespace resoct::bench
