@@ -80,8 +80,12 @@ std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, Render
 
 /// Per-frame averages of a run (benchmark time is per orbit; ms_frame is per frame).
 struct FrameAverages {
-  double ms_frame = 0, ms_device = 0, working_set_bytes = 0, samples_per_ray = 0, nodes_per_ray = 0,
-         bricks_touched = 0, brick_accesses_per_ray = 0;
+  double ms_frame = 0, ms_device = 0, cpu_ms_frame = 0, working_set_bytes = 0, samples_per_ray = 0,
+         nodes_per_ray = 0, bricks_touched = 0, brick_accesses_per_ray = 0;
+  /// The time mode ratios are computed from: the calling thread's CPU time for the CPU backend
+  /// (it renders on that thread when threads = 1, and CPU time does not count the time other
+  /// processes hold the core, so ratios survive a loaded machine), wall time otherwise.
+  double ratio_ms() const;
 };
 
 /// Renders all tables (one orbit) per benchmark iteration and returns per-frame averages; sets
