@@ -1,13 +1,20 @@
 // Scaling (issue 6 part 5, paper 002 Fig. 5).
 //
-//   BM_ScreenVsData/size_log2:<k>  one fixed view of procedural:tubes at 2^k voxels per axis;
+//   BM_ScreenVsData/size_log2:<k>/fixed_leaf:<f>  one fixed view of procedural:tubes at 2^k
+//     voxels per axis;
 //     a fresh Renderer (residency mode, global strategy, synchronous loading, backend under test
 //     with one render thread) renders from a cold cache until converged, then 3 steady frames. The
 //     level-of-detail choice should make the working set follow the screen, not the data:
 //     counters working_set_bricks / working_set_MiB (converged frame), ws_growth (working set
 //     over that of the smallest size of the run, same process), voxel_growth, frames,
-//     ms_to_converge, ms_steady (mean render_frame once converged), bricks_loaded, leaf (octree
-//     leaf edge, grown with the volume so that the node count stays ~2.4 M).
+//     ms_to_converge, ms_steady (mean render_frame once converged), bricks_loaded, leaf, and the
+//     last frame's samples_per_ray, nodes_per_ray, iterations_per_ray and host phases
+//     ms_last_render (frame tables + Backend::render), ms_last_backend (Backend::render alone),
+//     ms_last_update, ms_last_requests. Octree leaves:
+//     f = 0 grows the leaf with the volume (n / 32, at least 16: 32 leaves per axis at every
+//     size, like the screen-bound sampling level); f = 1 keeps 16³ leaves (up to 2048³; larger
+//     trees need > 300 MB of node words): nodes_per_ray then grows with the data, because the
+//     traversal descends to leaf depth whatever level it samples.
 //     Sizes 512³ .. 8192³ with 128² images (standard), 512² (--large); 512³ and 1024³
 //     with 32² (--smoke). 65536³ is described by the procedural source but not renderable:
 //     the page table is a flat array per level (level 0 of 65536³ at 32³ bricks would hold 2^33
@@ -43,8 +50,14 @@ std::uint32_t screen_image() {
 }
 
 void BM_ScreenVsData(benchmark::State& state) {
-  static std::map<int, double> ws_by_size;  // size_log2 -> working set bricks, this process
+  // (leaf rule, size_log2) -> working set bricks, this process
+  static std::map<std::pair<int, int>, double> ws_by_size;
   const int k = int(state.range(0));
+  const bool fixed_leaf = state.range(1) == 1;
+  if (fixed_leaf && k > 11) {
+    state.SkipWithError("fixed 16^3 leaves above 2048^3 need > 300 MB of octree words");
+    return;
+  }
   if (preset() == Preset::smoke && k > 10) {
     state.SkipWithError("smoke preset: sizes above 1024^3 skipped (page-table allocation)");
     return;
@@ -62,7 +75,7 @@ void BM_ScreenVsData(benchmark::State& state) {
   o.upload_budget.max_bricks = 1024;
   o.loader_threads = 0;
   o.device_cache_bytes = std::uint64_t(256) << 20;
-  o.leaf_size = glm::uvec3(std::uint32_t(std::max<std::uint64_t>(16, n / 128)));
+  o.leaf_size = glm::uvec3(fixed_leaf ? 16u : std::uint32_t(std::max<std::uint64_t>(16, n / 32)));
   const Scene scene = source_scene(source->volume(), 1, screen_image(), false);
   ConvergeRun run;
   for (auto _ : state) {
@@ -70,9 +83,11 @@ void BM_ScreenVsData(benchmark::State& state) {
     benchmark::DoNotOptimize(run.image.pixels().data());
   }
   const double ws = double(run.working_set_bricks);
-  if (ws_by_size.empty() || k < ws_by_size.begin()->first) ws_by_size.clear();
-  ws_by_size[k] = ws;
-  const auto& [k0, ws0] = *ws_by_size.begin();
+  const int rule = fixed_leaf ? 1 : 0;
+  ws_by_size[{rule, k}] = ws;
+  const auto first = ws_by_size.lower_bound({rule, 0});
+  const int k0 = first->first.second;
+  const double ws0 = first->second;
   state.counters["working_set_bricks"] = ws;
   state.counters["working_set_MiB"] = double(run.working_set_bytes) / double(1 << 20);
   state.counters["ws_growth"] = ws0 > 0 ? ws / ws0 : 0.0;
@@ -83,12 +98,22 @@ void BM_ScreenVsData(benchmark::State& state) {
   state.counters["ms_steady"] = run.ms_steady;
   state.counters["bricks_loaded"] = double(run.bricks_loaded);
   state.counters["leaf"] = o.leaf_size.x;
-  state.SetLabel(std::to_string(n) + "^3");
+  const BackendStats& b = run.last.backend;
+  const double rays = double(std::max<std::uint64_t>(b.rays, 1));
+  state.counters["samples_per_ray"] = double(b.samples) / rays;
+  state.counters["nodes_per_ray"] = double(b.nodes_visited) / rays;
+  state.counters["iterations_per_ray"] = double(b.iterations) / rays;
+  // Where a steady frame's time goes (host wall ms of the last frame's phases).
+  state.counters["ms_last_render"] = run.last.ms_render;
+  state.counters["ms_last_backend"] = b.ms_render;
+  state.counters["ms_last_update"] = run.last.ms_update;
+  state.counters["ms_last_requests"] = run.last.ms_requests;
+  state.SetLabel(std::to_string(n) + "^3/leaf " + std::to_string(o.leaf_size.x));
 }
 
 BENCHMARK(BM_ScreenVsData)
-    ->DenseRange(9, 13)
-    ->ArgNames({"size_log2"})
+    ->ArgsProduct({benchmark::CreateDenseRange(9, 13, 1), {0, 1}})
+    ->ArgNames({"size_log2", "fixed_leaf"})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

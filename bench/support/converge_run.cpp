@@ -56,6 +56,7 @@ ConvergeRun converge(std::shared_ptr<const BrickSource> source, const Scene& sce
     run.ms_steady = std::chrono::duration<double, std::milli>(Clock::now() - t0).count() /
                     double(steady_frames);
   }
+  run.last = report.stats;
   run.image = std::move(report.image);
   return run;
 }

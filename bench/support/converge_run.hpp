@@ -7,6 +7,7 @@
 #include <string>
 
 #include "resoct/brick_source.hpp"
+#include "resoct/frame_stats.hpp"
 #include "resoct/image.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
@@ -29,7 +30,8 @@ struct ConvergeRun {
   std::uint64_t working_set_bytes = 0;
   std::uint64_t brick_bytes = 0;  ///< padded bytes of one brick
   std::uint32_t cache_slots = 0;
-  Image image;  ///< the last frame
+  FrameStats last;  ///< statistics of the last frame
+  Image image;      ///< the last frame
 };
 
 /// A scene over dataset channels 0..visible-1 with the rig's transfer functions (duplicate_tf
