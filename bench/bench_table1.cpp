@@ -19,9 +19,11 @@
 // Counters: ms_frame, working_set_MiB (distinct bricks sampled per frame × padded brick bytes),
 // samples_per_ray, nodes_per_ray, bricks_touched, brick_accesses_per_ray; on residency rows
 // also res_over_pt / res_over_oct (ms) and ws_res_over_pt / ws_res_over_oct (working set).
+// Octree leaves 16³, or RESOCT_BENCH_LEAF³ (e.g. RESOCT_BENCH_LEAF=32).
 // Sizes: 256³ and 512×512×40 with 256² images (standard), 1024³ and 1024×1024×40 with 512²
 // (--large or RESOCT_BENCH_LARGE=1), 48³ and 64×64×40 with 32² (--smoke or
 // RESOCT_BENCH_SMOKE=1).
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -55,6 +57,14 @@ std::uint32_t image_size() {
   return preset() == Preset::smoke ? 32u : preset() == Preset::large ? 512u : 256u;
 }
 
+// Octree leaf edge: 16 unless RESOCT_BENCH_LEAF says otherwise (the leaf study of
+// bench_decoupling, applied to the Table 1 datasets).
+std::uint32_t leaf_edge() {
+  const char* v = std::getenv("RESOCT_BENCH_LEAF");
+  const long n = v != nullptr ? std::strtol(v, nullptr, 10) : 0;
+  return n >= 1 && n <= 4096 ? std::uint32_t(n) : 16u;
+}
+
 // One rig at a time (benchmarks run dataset by dataset), so memory stays that of the largest
 // single dataset.
 Rig& rig_for(int dataset) {
@@ -65,8 +75,8 @@ Rig& rig_for(int dataset) {
     const std::uint32_t n = dataset == 4 ? 16u : 4u;
     std::vector<std::uint32_t> channels;
     for (std::uint32_t c = 0; c < n; ++c) channels.push_back(c);
-    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32), glm::uvec3(16),
-                                dataset == 4 ? 0u : n);
+    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32),
+                                glm::uvec3(leaf_edge()), dataset == 4 ? 0u : n);
     key = dataset;
   }
   return *rig;
