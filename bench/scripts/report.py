@@ -250,17 +250,22 @@ def scaling(ctx, rows, out, plots):
     if screen:
         out.append("Screen vs data: fixed view of procedural tubes, cold cache to convergence.\n")
         out.append("| volume | voxels × | leaf | frames | converged | working set bricks | "
-                   "working set MiB | WS × | ms to converge | ms/frame steady | bricks loaded |")
-        out.append("|---|---|---|---|---|---|---|---|---|---|---|")
+                   "working set MiB | WS × | ms to converge | ms/frame steady | bricks loaded | "
+                   "samples/ray | nodes/ray |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         by_k = {}
         for a, b in screen:
             k = a["size_log2"]
-            by_k[k] = b["working_set_bricks"]
-            out.append(f"| {2 ** k}³ | {fmt(b['voxel_growth'])} | {fmt(b['leaf'])} | "
+            fixed = a.get("fixed_leaf", 0) == 1
+            if not fixed:
+                by_k[k] = b["working_set_bricks"]
+            leaf = f"{fmt(b['leaf'])}³" + (" (fixed)" if fixed else " (n/32)")
+            out.append(f"| {2 ** k}³ | {fmt(b['voxel_growth'])} | {leaf} | "
                        f"{fmt(b['frames'])} | {'yes' if b['converged'] else 'no'} | "
                        f"{fmt(b['working_set_bricks'])} | {fmt(b['working_set_MiB'])} | "
                        f"{fmt(b['ws_growth'])} | {fmt(b['ms_to_converge'])} | "
-                       f"{fmt(b['ms_steady'])} | {fmt(b['bricks_loaded'])} |")
+                       f"{fmt(b['ms_steady'])} | {fmt(b['bricks_loaded'])} | "
+                       f"{fmt(b.get('samples_per_ray'))} | {fmt(b.get('nodes_per_ray'))} |")
         out.append("")
         # Working-set growth over every 64x step in voxels (2 steps of size_log2).
         steps = [(k, by_k[k + 2] / by_k[k]) for k in sorted(by_k) if k + 2 in by_k and by_k[k]]
@@ -331,7 +336,8 @@ def micro(results, out):
     if t:
         for args, b in t[1]:
             if "ns_per_iteration" in b:
-                rows.append((f"per-sample traversal, {b['name'].split('/', 1)[1]}",
+                rows.append((f"per-iteration traversal (wall time), "
+                             f"{b['name'].split('/', 1)[1].replace('/real_time', '')}",
                              b["ns_per_iteration"], "`traverse` ns_per_iteration"))
     if not rows:
         return
