@@ -117,7 +117,7 @@ const Image& reference_for(int dataset, const Scene& scene) {
   o.step = preset() == Preset::smoke ? 0.25 : 0.125;
   o.early_termination = false;
   return cache[dataset] = test::render_reference(
-             scene, v, level0_voxels(*rig.source, visible_channels(dataset)), o);
+             scene, v, level0_voxels(*rig.procedural, visible_channels(dataset)), o);
 }
 
 void BM_Accuracy(benchmark::State& state) {
@@ -159,7 +159,7 @@ void BM_Accuracy(benchmark::State& state) {
   std::vector<FrameTables> tables{rig.resident->tables(scene, o)};
   if (uncorrected) tables[0].frame.ref_step *= float(scene.step_scale);
   FrameResult first;
-  rig.backend.render(tables[0], first);
+  rig.backend->render(tables[0], first);
   const ImageDiff diff = compare_images(first.image, reference);
   run_frames(state, rig, tables);
   state.counters["rmse"] = diff.rmse_rgb;

@@ -1,5 +1,6 @@
 // Residency octree update cost per brick add and evict, against tree depth (leaf size), visible
-// slots and brick level, on a 2048³ hierarchy with 32³ bricks.
+// slots and brick level, on a 2048³ hierarchy with 32³ bricks (256³ with RESOCT_BENCH_SMOKE=1,
+// the ctest smoke run, where building the 2048³ trees alone took ~50 s).
 //
 //   BM_OctreeAddEvict/<leaf>/<slots>/<level>  one brick_added + one brick_evicted per item
 //   BM_OctreeAdd/..., BM_OctreeEvict/...      the two halves separately, in batches of distinct
@@ -13,6 +14,8 @@
 // kMaxStorage are skipped with a message; bytes_per_node reports what they would need.
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -25,7 +28,11 @@ namespace {
 
 using namespace resoct;
 
-constexpr std::uint64_t kExtent = 2048;
+std::uint64_t extent() {
+  const char* smoke = std::getenv("RESOCT_BENCH_SMOKE");
+  const bool small = smoke != nullptr && *smoke != '\0' && std::strcmp(smoke, "0") != 0;
+  return small ? 256 : 2048;
+}
 constexpr std::uint64_t kMaxStorage = std::uint64_t(1536) << 20;  // bytes of node words
 
 struct Setup {
@@ -37,7 +44,7 @@ struct Setup {
   }
   static BrickHierarchy make() {
     VolumeDesc v;
-    v.extent = glm::u64vec3(kExtent);
+    v.extent = glm::u64vec3(extent());
     v.type = VoxelType::u16;
     BrickLayout l;
     l.brick_size = glm::uvec3(32);
@@ -65,7 +72,7 @@ void run(benchmark::State& state, Mode mode) {
   const auto leaf = std::uint32_t(state.range(0));
   const auto slots = std::uint32_t(state.range(1));
   const auto level = std::uint32_t(state.range(2));
-  const OctreeLayout layout{glm::u64vec3(kExtent), glm::uvec3(leaf)};
+  const OctreeLayout layout{glm::u64vec3(extent()), glm::uvec3(leaf)};
   const std::uint64_t bytes = layout.node_count() * ResidencyOctree::bytes_per_node(slots);
   state.counters["nodes"] = double(layout.node_count());
   state.counters["depths"] = double(layout.depth_count());

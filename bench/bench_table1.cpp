@@ -1,7 +1,8 @@
 // Paper 000 Table 1 analogue: the three render modes side by side on the procedural analogues of
-// the paper's datasets, CPU backend, one thread, everything resident (every level of every
-// loaded channel), camera rotating about the up axis (one benchmark iteration = one orbit of
-// 2 / 4 / 16 positions for smoke / standard / large; ms_frame is per frame).
+// the paper's datasets, everything resident (every level of every loaded channel), camera
+// rotating about the up axis (one benchmark iteration = one orbit of 2 / 4 / 16 positions for
+// smoke / standard / large; ms_frame is per frame). Backend: CPU on one thread, or the one named
+// by RESOCT_BENCH_BACKEND / --backend=NAME (e.g. vulkan).
 // Timed: Backend::render alone (the frame tables are built beforehand), so ms/frame is the
 // traversal's cost.
 //
@@ -9,17 +10,20 @@
 //     d = 0 tubes (sparse, ~ Kingsnake), 1 noisefloor (sparse blobs on a transparent noise floor,
 //         ~ Beechnut / neurons), 2 turbulence (dense, ~ Rayleigh-Taylor), 3 mandelbulb,
 //         4 cells (thin multi-channel slab, ~ CyCIF)
-//     c = visible channels: 1 and 4 (16 for cells). The paper simulates extra channels by
-//         duplicating one with different transfer functions; the procedural sources draw each
-//         channel from its own seed instead, so every channel is distinct data of the same kind.
+//     c = visible channels: 1 and 4 (16 for cells). As in the paper, the 4-channel rows of the
+//         single-channel datasets (0-3) duplicate channel 0 four times (DuplicateChannelSource)
+//         and render copy k with its own transfer function (duplicate_tf: transparent below
+//         0.1 + 0.125 k); cells has 16 distinct marker channels of its own.
 //     m = 1 pagetable, 2 octree, 0 residency (run in this order, so the residency run can
 //         report its ratios against the other two from the same process)
 // Counters: ms_frame, working_set_MiB (distinct bricks sampled per frame × padded brick bytes),
 // samples_per_ray, nodes_per_ray, bricks_touched, brick_accesses_per_ray; on residency rows
 // also res_over_pt / res_over_oct (ms) and ws_res_over_pt / ws_res_over_oct (working set).
+// Octree leaves 16³, or RESOCT_BENCH_LEAF³ (e.g. RESOCT_BENCH_LEAF=32).
 // Sizes: 256³ and 512×512×40 with 256² images (standard), 1024³ and 1024×1024×40 with 512²
 // (--large or RESOCT_BENCH_LARGE=1), 48³ and 64×64×40 with 32² (--smoke or
 // RESOCT_BENCH_SMOKE=1).
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -46,11 +50,19 @@ std::string spec_for(int dataset) {
   const char* size = p == Preset::smoke   ? "48x48x48"
                      : p == Preset::large ? "1024x1024x1024"
                                           : "256x256x256";
-  return std::string("procedural:") + kNames[dataset] + ":" + size + ":4";
+  return std::string("procedural:") + kNames[dataset] + ":" + size + ":1";
 }
 
 std::uint32_t image_size() {
   return preset() == Preset::smoke ? 32u : preset() == Preset::large ? 512u : 256u;
+}
+
+// Octree leaf edge: 16 unless RESOCT_BENCH_LEAF says otherwise (the leaf study of
+// bench_decoupling, applied to the Table 1 datasets).
+std::uint32_t leaf_edge() {
+  const char* v = std::getenv("RESOCT_BENCH_LEAF");
+  const long n = v != nullptr ? std::strtol(v, nullptr, 10) : 0;
+  return n >= 1 && n <= 4096 ? std::uint32_t(n) : 16u;
 }
 
 // One rig at a time (benchmarks run dataset by dataset), so memory stays that of the largest
@@ -63,7 +75,8 @@ Rig& rig_for(int dataset) {
     const std::uint32_t n = dataset == 4 ? 16u : 4u;
     std::vector<std::uint32_t> channels;
     for (std::uint32_t c = 0; c < n; ++c) channels.push_back(c);
-    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32), glm::uvec3(16));
+    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32),
+                                glm::uvec3(leaf_edge()), dataset == 4 ? 0u : n);
     key = dataset;
   }
   return *rig;
@@ -83,11 +96,11 @@ void BM_Table1(benchmark::State& state) {
     const auto pt = done.find({dataset, channels, int(RenderMode::pagetable)});
     const auto oct = done.find({dataset, channels, int(RenderMode::octree)});
     if (pt != done.end()) {
-      state.counters["res_over_pt"] = a.ms_frame / pt->second.ms_frame;
+      state.counters["res_over_pt"] = a.ratio_ms() / pt->second.ratio_ms();
       state.counters["ws_res_over_pt"] = a.working_set_bytes / pt->second.working_set_bytes;
     }
     if (oct != done.end()) {
-      state.counters["res_over_oct"] = a.ms_frame / oct->second.ms_frame;
+      state.counters["res_over_oct"] = a.ratio_ms() / oct->second.ratio_ms();
       state.counters["ws_res_over_oct"] = a.working_set_bytes / oct->second.working_set_bytes;
     }
   }

@@ -11,9 +11,12 @@
 // iterations_per_ray, nodes_per_ray, brick_accesses_per_ray, skipped_fraction = distance skipped
 // / (skipped + marched). Channels are forced to level 0 so all modes render the same image.
 // Set-up (loading every level-0 brick and the leaf metadata) is paid once per dataset and
-// channel count, outside the timing.
+// channel count, outside the timing. RESOCT_BENCH_SMOKE=1 (ctest) shrinks to 48³ / 64×64×40
+// and 32² images.
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -30,6 +33,11 @@
 namespace {
 
 using namespace resoct;
+
+bool smoke() {
+  const char* v = std::getenv("RESOCT_BENCH_SMOKE");
+  return v != nullptr && *v != '\0' && std::strcmp(v, "0") != 0;
+}
 
 struct Rig {
   std::unique_ptr<BrickSource> source;
@@ -125,7 +133,7 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
   Scene& sc = rig->scene;
   sc.camera.eye = {1.6, 1.2, 1.9};
   sc.camera.target = {0.5, 0.5 * box_extent(vol).y, 0.5 * box_extent(vol).z};
-  sc.viewport = {256, 256};
+  sc.viewport = smoke() ? Viewport{32, 32} : Viewport{256, 256};
   sc.step_scale = 1.0;
   for (std::uint32_t s = 0; s < n; ++s) {
     ChannelSettings c;
@@ -149,9 +157,12 @@ Rig& rig_for(int dataset, std::uint32_t channels) {
   static std::unique_ptr<Rig> rig;
   if (!rig || key != std::pair<int, std::uint32_t>{dataset, channels}) {
     rig.reset();
-    const std::string spec = dataset == 0 ? (channels == 1 ? "procedural:tubes:256x256x256"
-                                                           : "procedural:tubes:256x256x256:16")
-                                          : "procedural:cells:256x256x40:16";
+    // The ctest smoke run (RESOCT_BENCH_SMOKE=1) only checks that the program works.
+    const std::string size = smoke() ? "48x48x48" : "256x256x256";
+    const std::string spec =
+        dataset == 0
+            ? "procedural:tubes:" + size + (channels == 1 ? "" : ":16")
+            : std::string("procedural:cells:") + (smoke() ? "64x64x40" : "256x256x40") + ":16";
     rig = make_rig(spec, channels);
     key = {dataset, channels};
   }

@@ -1,10 +1,13 @@
 #!/usr/bin/python3
-"""Turns the JSON of bench_table1, bench_decoupling and bench_accuracy into Markdown tables,
-Pareto-front CSVs and (when matplotlib is installed) PNG plots.
+"""Turns the JSON of bench_table1, bench_decoupling, bench_accuracy, bench_out_of_core,
+bench_scaling and the micro-benchmarks into Markdown tables, Pareto-front CSVs and (when
+matplotlib is installed) PNG plots.
 
   python3 bench/scripts/report.py [--results bench/results] [--readme bench/README.md]
 
-Reads <results>/{table1,decoupling,accuracy}.json (whichever exist), writes
+Reads <results>/{table1,decoupling,accuracy,out_of_core,scaling}.json and the micro-benchmark
+outputs <results>/micro_{octree,brick_cache,request_set,page_table,traverse}.json (whichever
+exist), writes
 <results>/results.md, <results>/pareto_<dataset>.csv and <results>/*.png, and replaces the text
 between the "results:begin" / "results:end" markers of the README with results.md.
 Python 3 standard library; plots need python3-matplotlib (Debian), skipped with a note otherwise.
@@ -31,7 +34,7 @@ def load(path):
         data = json.load(f)
     rows = []
     for b in data.get("benchmarks", []):
-        if b.get("run_type", "iteration") != "iteration":
+        if b.get("run_type", "iteration") != "iteration" or b.get("error_occurred"):
             continue
         args = dict((k, int(v)) for k, v in re.findall(r"(\w+):(\d+)", b["name"]))
         rows.append((args, b))
@@ -48,6 +51,7 @@ def fmt(x, digits=3):
 
 def context_line(ctx):
     return (f"{ctx.get('date', '?')}, preset `{ctx.get('resoct_preset', '?')}`, "
+            f"backend `{ctx.get('resoct_backend', 'cpu')}`, "
             f"{ctx.get('num_cpus', '?')} CPUs @ {ctx.get('mhz_per_cpu', '?')} MHz, "
             f"load average {', '.join(f'{x:.1f}' for x in ctx.get('load_avg', []))}")
 
@@ -55,9 +59,11 @@ def context_line(ctx):
 def table1(ctx, rows, out):
     out.append("### Table 1 analogue (`bench_table1`)\n")
     out.append(context_line(ctx) + "\n")
-    out.append("| dataset | ch | mode | ms/frame | working set MiB | samples/ray | nodes/ray | "
-               "bricks touched | res/pt ms | res/oct ms | res/pt WS | res/oct WS |")
-    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    out.append("Ratios are of CPU ms (the render thread's CPU time) when the CPU backend ran, else of "
+               "wall ms.\n")
+    out.append("| dataset | ch | mode | ms/frame | CPU ms | working set MiB | samples/ray | "
+               "nodes/ray | bricks touched | res/pt ms | res/oct ms | res/pt WS | res/oct WS |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     ratios = {}
     for args, b in rows:
         d, c, m = args["dataset"], args["channels"], args["mode"]
@@ -66,7 +72,7 @@ def table1(ctx, rows, out):
         if m == 0:
             ratios[(TABLE1_NAMES[d], c)] = r
         out.append(f"| {TABLE1_NAMES[d]} | {c} | {MODES[m]} | {fmt(b['ms_frame'])} | "
-                   f"{fmt(b['working_set_MiB'])} | {fmt(b['samples_per_ray'])} | "
+                   f"{fmt(b.get('cpu_ms_frame'))} | {fmt(b['working_set_MiB'])} | {fmt(b['samples_per_ray'])} | "
                    f"{fmt(b['nodes_per_ray'])} | {fmt(b['bricks_touched'])} | "
                    + " | ".join(fmt(x) if m == 0 else "" for x in r) + " |")
     out.append("")
@@ -183,7 +189,167 @@ def accuracy(ctx, rows, out, plots):
     return verdicts
 
 
-def targets(ratios, verdicts, out):
+OOC_NAMES = ["tubes (4 copies)", "turbulence"]
+
+
+def out_of_core(ctx, rows, out, plots):
+    out.append("### Out-of-core behaviour (`bench_out_of_core`, cold cache)\n")
+    out.append(context_line(ctx) + "\n")
+    out.append("Cache = fraction of the converged working set; frames capped (not converged: "
+               "the row ran to the cap; rmse = last image vs the converged baseline image).\n")
+    out.append("| dataset | strategy | cache | budget | frames | converged | ms to converge | "
+               "MiB loaded | MiB uploaded | evictions | rmse |")
+    out.append("|---|---|---|---|---|---|---|---|---|---|---|")
+    ws = {}
+    for args, b in rows:
+        d = args["dataset"]
+        ws[d] = (b.get("working_set_bricks"), b.get("cache_slots") if args["cache_div"] == 1
+                 else ws.get(d, (None, None))[1])
+        out.append(f"| {OOC_NAMES[d]} | {'greedy' if args['strategy'] == 0 else 'global'} | "
+                   f"1/{args['cache_div']} ({fmt(b['cache_slots'])} slots) | {args['budget']} | "
+                   f"{fmt(b['frames'])} | {'yes' if b['converged'] else 'no'} | "
+                   f"{fmt(b['ms_to_converge'])} | {fmt(b['MiB_loaded'])} | "
+                   f"{fmt(b['MiB_uploaded'])} | {fmt(b['evictions'])} | {b['rmse']:.4f} |")
+    out.append("")
+    for d, (w, _) in sorted(ws.items()):
+        out.append(f"- {OOC_NAMES[d]}: working set of the converged view {fmt(w)} bricks.")
+    out.append("")
+    if plots is not None and rows:
+        plt = plots
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        for d in sorted({a["dataset"] for a, _ in rows}):
+            for s_, style in ((0, "-"), (1, "--")):
+                pts = sorted((a["budget"], b["frames"]) for a, b in rows
+                             if a["dataset"] == d and a["strategy"] == s_ and a["cache_div"] == 1)
+                axes[0].plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o",
+                             label=f"{OOC_NAMES[d]} {'greedy' if s_ == 0 else 'global'}")
+                pts = sorted((1.0 / a["cache_div"], b["MiB_uploaded"]) for a, b in rows
+                             if a["dataset"] == d and a["strategy"] == s_ and a["budget"] == 256)
+                axes[1].plot([p[0] for p in pts], [p[1] for p in pts], style, marker="o",
+                             label=f"{OOC_NAMES[d]} {'greedy' if s_ == 0 else 'global'}")
+        axes[0].set_xscale("log", base=2)
+        axes[0].set_xlabel("upload budget (bricks/frame), cache 1x")
+        axes[0].set_ylabel("frames (to convergence or cap)")
+        axes[1].set_xscale("log", base=2)
+        axes[1].set_xlabel("cache / working set, budget 256")
+        axes[1].set_ylabel("MiB uploaded")
+        for ax in axes:
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(os.path.join(RESULTS, "out_of_core.png"), dpi=110)
+        plt.close(fig)
+        out.append("![out of core](results/out_of_core.png)\n")
+
+
+def scaling(ctx, rows, out, plots):
+    out.append("### Scaling (`bench_scaling`)\n")
+    out.append(context_line(ctx) + "\n")
+    screen = [(a, b) for a, b in rows if "size_log2" in a]
+    growth = None
+    if screen:
+        out.append("Screen vs data: fixed view of procedural tubes, cold cache to convergence.\n")
+        out.append("| volume | voxels × | leaf | frames | converged | working set bricks | "
+                   "working set MiB | WS × | ms to converge | ms/frame steady | bricks loaded | "
+                   "samples/ray | nodes/ray |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        by_k = {}
+        for a, b in screen:
+            k = a["size_log2"]
+            fixed = a.get("fixed_leaf", 0) == 1
+            if not fixed:
+                by_k[k] = b["working_set_bricks"]
+            leaf = f"{fmt(b['leaf'])}³" + (" (fixed)" if fixed else " (n/32)")
+            out.append(f"| {2 ** k}³ | {fmt(b['voxel_growth'])} | {leaf} | "
+                       f"{fmt(b['frames'])} | {'yes' if b['converged'] else 'no'} | "
+                       f"{fmt(b['working_set_bricks'])} | {fmt(b['working_set_MiB'])} | "
+                       f"{fmt(b['ws_growth'])} | {fmt(b['ms_to_converge'])} | "
+                       f"{fmt(b['ms_steady'])} | {fmt(b['bricks_loaded'])} | "
+                       f"{fmt(b.get('samples_per_ray'))} | {fmt(b.get('nodes_per_ray'))} |")
+        out.append("")
+        # Working-set growth over every 64x step in voxels (2 steps of size_log2).
+        steps = [(k, by_k[k + 2] / by_k[k]) for k in sorted(by_k) if k + 2 in by_k and by_k[k]]
+        if steps:
+            growth = max(g for _, g in steps)
+            out.append("Working set growth per 64× voxels: " + ", ".join(
+                f"{2 ** k}³→{2 ** (k + 2)}³ {g:.2f}×" for k, g in steps) + ".\n")
+        if plots is not None:
+            plt = plots
+            fig, ax = plt.subplots(figsize=(6, 4))
+            ks = sorted(by_k)
+            ax.plot([8.0 ** (k - ks[0]) for k in ks], [by_k[k] for k in ks], "-o",
+                    label="working set (bricks)")
+            ax.set_xscale("log")
+            ax.set_xlabel("voxels relative to 512³")
+            ax.set_ylabel("working set (bricks)")
+            ax.set_ylim(bottom=0)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            fig.savefig(os.path.join(RESULTS, "scaling.png"), dpi=110)
+            plt.close(fig)
+            out.append("![scaling](results/scaling.png)\n")
+    threads = [(a, b) for a, b in rows if "threads" in a and "ms_frame" in b]
+    if threads:
+        out.append("Threads (CPU backend, everything resident, residency mode, wall ms/frame):\n")
+        out.append("| dataset | threads | ms/frame | speed-up | efficiency |")
+        out.append("|---|---|---|---|---|")
+        for a, b in threads:
+            out.append(f"| {['tubes', 'turbulence'][a['dataset']]} | {a['threads']} | "
+                       f"{fmt(b['ms_frame'])} | {fmt(b.get('speedup'))} | "
+                       f"{fmt(b.get('efficiency'))} |")
+        out.append("")
+    return growth
+
+
+MICRO = [
+    # (file, benchmark name, counter or None for real/cpu time, operation)
+    ("micro_octree", "BM_OctreeAddEvict/16/4/0", "ns_per_brick",
+     "octree add + evict, level-0 brick (leaf 16³, 4 slots)"),
+    ("micro_octree", "BM_OctreeAdd/16/4/0", "ns_per_brick", "octree add, level-0 brick"),
+    ("micro_octree", "BM_OctreeEvict/16/4/0", "ns_per_brick", "octree evict, level-0 brick"),
+    ("micro_brick_cache", "BM_CacheTouch/0", None, "LRU touch"),
+    ("micro_brick_cache", "BM_CacheEvict/0", None, "LRU evict (insert into a full cache)"),
+    ("micro_brick_cache", "BM_CacheTouch/1", None, "Octreemizer touch"),
+    ("micro_brick_cache", "BM_CacheEvict/1", None, "Octreemizer evict"),
+    ("micro_request_set", "BM_RequestSetInsert/threads:1", None, "request-set insert (1 thread)"),
+    ("micro_page_table", "BM_PageTableTranslate", None, "page-table lookup (translate)"),
+]
+
+
+def micro(results, out):
+    rows = []
+    for file, name, counter, what in MICRO:
+        t = load(os.path.join(results, file + ".json"))
+        if not t:
+            continue
+        for _, b in t[1]:
+            if b["name"] == name:
+                if counter:
+                    ns = b.get(counter)
+                else:
+                    scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}[b.get("time_unit", "ns")]
+                    ns = b["cpu_time"] * scale
+                rows.append((what, ns, f"`{file[6:]}` {name}"))
+                break
+    t = load(os.path.join(results, "micro_traverse.json"))
+    if t:
+        for args, b in t[1]:
+            if "ns_per_iteration" in b:
+                rows.append((f"per-iteration traversal (wall time), "
+                             f"{b['name'].split('/', 1)[1].replace('/real_time', '')}",
+                             b["ns_per_iteration"], "`traverse` ns_per_iteration"))
+    if not rows:
+        return
+    out.append("### Micro-benchmarks (ns/op, CPU time)\n")
+    out.append("| operation | ns/op | source |")
+    out.append("|---|---|---|")
+    for what, ns, src in rows:
+        out.append(f"| {what} | {fmt(ns)} | {src} |")
+    out.append("")
+
+
+def targets(ratios, verdicts, out, growth=None):
     out.append("### Issue targets\n")
     out.append("| target | measured | verdict |")
     out.append("|---|---|---|")
@@ -215,6 +381,8 @@ def targets(ratios, verdicts, out):
     for name, (_, _, v) in sorted(verdicts.items()):
         row(f"{name}: speed-up at RMSE ≤ 1/255 ≥ 2×", v[1], 2.0, True)
         row(f"{name}: speed-up at RMSE ≤ 4/255 ≥ 5×", v[4], 5.0, True)
+    if growth is not None:
+        row("working set growth per 64× voxels at a fixed view ≤ 1.3×", growth, 1.3)
     out.append("")
 
 
@@ -246,7 +414,15 @@ def main():
     t = load(os.path.join(RESULTS, "accuracy.json"))
     if t:
         verdicts = accuracy(*t, out, plots)
-    targets(ratios, verdicts, out)
+    t = load(os.path.join(RESULTS, "out_of_core.json"))
+    if t:
+        out_of_core(*t, out, plots)
+    growth = None
+    t = load(os.path.join(RESULTS, "scaling.json"))
+    if t:
+        growth = scaling(*t, out, plots)
+    micro(RESULTS, out)
+    targets(ratios, verdicts, out, growth)
     text = "\n".join(out)
     with open(os.path.join(RESULTS, "results.md"), "w", encoding="utf-8") as f:
         f.write(text.replace("](results/", "]("))

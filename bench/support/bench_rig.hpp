@@ -1,8 +1,9 @@
 #pragma once
-// Shared rig of the paper-comparison benchmarks (bench_table1, bench_decoupling, bench_accuracy):
-// size presets, "everything resident" set-up of a procedural source on a CPU backend (the tests'
-// ResidentScene, so the benchmarks measure exactly what the tests verify), the rotating camera
-// of paper 000 §8, and per-frame statistics with the working set.
+// Shared rig of the paper-comparison benchmarks (bench_table1, bench_decoupling, bench_accuracy,
+// bench_out_of_core, bench_scaling): size presets, the backend under test (cpu or vulkan, chosen
+// by RESOCT_BENCH_BACKEND or --backend=NAME), "everything resident" set-up of a procedural
+// source (the tests' ResidentScene, so the benchmarks measure exactly what the tests verify), the
+// rotating camera of paper 000 §8, and per-frame statistics with the working set.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -11,7 +12,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "resoct/cpu/cpu_backend.hpp"
+#include "resoct/backend.hpp"
 #include "resoct/procedural_source.hpp"
 #include "support/resident_scene.hpp"
 
@@ -21,24 +22,37 @@ namespace resoct::bench {
 /// machines, 1024³ class).
 enum class Preset { smoke, standard, large };
 
-/// Reads RESOCT_BENCH_SMOKE / RESOCT_BENCH_LARGE and removes --smoke / --large from argv (before
-/// benchmark::Initialize sees them). Call once from main.
+/// Reads RESOCT_BENCH_SMOKE / RESOCT_BENCH_LARGE / RESOCT_BENCH_BACKEND and removes --smoke /
+/// --large / --backend=NAME from argv (before benchmark::Initialize sees them); registers the
+/// backends this build has ("cpu", and "vulkan" when built with RESOCT_WITH_VULKAN). Throws
+/// Error(invalid_argument) naming "backend" for an unknown backend. Call once from main.
 Preset init_preset(int& argc, char** argv);
-/// The main() of every rig benchmark: reads the preset flags, then runs Google Benchmark.
+/// The main() of every rig benchmark: reads the preset and backend flags, then runs Google
+/// Benchmark. Returns 1 (with one line on stderr) when a flag is bad.
 int run_benchmarks(int argc, char** argv);
 /// The preset chosen by init_preset.
 Preset preset();
 const char* to_string(Preset p);
 
-/// A procedural source with every level of the given channels resident on a one-thread CPU
-/// backend (one thread so that ms/frame is the traversal's cost, not the machine's parallelism).
+/// The backend under test ("cpu" unless RESOCT_BENCH_BACKEND or --backend says otherwise).
+const std::string& backend_name();
+/// A new backend under test; `threads` is honoured by the CPU backend (<= 0: all cores).
+std::unique_ptr<Backend> make_backend(int threads);
+
+/// A procedural source with every level of the given channels resident on the backend under
+/// test (the CPU backend on one thread by default, so that ms/frame is the traversal's cost, not
+/// the machine's parallelism). With `duplicates` > 0 the source shows channel 0 of `spec` as
+/// that many identical channels (DuplicateChannelSource: the paper's multi-channel protocol for
+/// single-channel data) and bench_scene gives each copy its own value window.
 struct Rig {
   Rig(const std::string& spec, std::vector<std::uint32_t> channels, glm::uvec3 brick_size,
-      glm::uvec3 leaf_size);
-  std::unique_ptr<ProceduralSource> source;
+      glm::uvec3 leaf_size, std::uint32_t duplicates = 0, int threads = 1);
+  std::shared_ptr<ProceduralSource> procedural;  ///< the generated data
+  std::shared_ptr<const BrickSource> source;     ///< what is rendered (procedural or duplicated)
   std::unique_ptr<test::ResidentScene> resident;
-  cpu::CpuBackend backend{1};
+  std::unique_ptr<Backend> backend;
   std::size_t brick_bytes = 0;  ///< padded bytes of one cache slot
+  bool duplicated = false;
 };
 
 /// Camera `angle` radians around the up (y) axis through the volume's centre, at distance 1.6
@@ -48,6 +62,10 @@ Camera orbit_camera(const VolumeDesc& volume, double angle);
 /// A transfer function transparent below 0.1 (hides the noise floor), rising to a per-channel
 /// hue; channel k of n.
 TransferFunction bench_tf(std::uint32_t k, std::uint32_t n);
+/// Transfer function of copy k of n of a duplicated channel (paper 000 §8: "rendering channels
+/// with different transfer functions"): transparent below 0.1 + 0.5 k / n, so copy 0 is
+/// bench_tf's window and later copies show progressively denser parts of the same data.
+TransferFunction duplicate_tf(std::uint32_t k, std::uint32_t n);
 
 /// A scene over the first `visible` slots of `rig` with bench_tf and the given level range.
 Scene bench_scene(const Rig& rig, std::uint32_t visible, std::uint32_t image,
@@ -62,12 +80,18 @@ std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, Render
 
 /// Per-frame averages of a run (benchmark time is per orbit; ms_frame is per frame).
 struct FrameAverages {
-  double ms_frame = 0, working_set_bytes = 0, samples_per_ray = 0, nodes_per_ray = 0,
-         bricks_touched = 0, brick_accesses_per_ray = 0;
+  double ms_frame = 0, ms_device = 0, cpu_ms_frame = 0, working_set_bytes = 0, samples_per_ray = 0,
+         nodes_per_ray = 0, bricks_touched = 0, brick_accesses_per_ray = 0;
+  /// The time mode ratios are computed from: the calling thread's CPU time for the CPU backend
+  /// (it renders on that thread when threads = 1, and CPU time does not count the time other
+  /// processes hold the core, so ratios survive a loaded machine), wall time otherwise.
+  double ratio_ms() const;
 };
 
 /// Renders all tables (one orbit) per benchmark iteration and returns per-frame averages; sets
-/// the counters ms_frame, working_set_MiB, samples_per_ray, nodes_per_ray, bricks_touched.
+/// the counters ms_frame (host wall time of Backend::render), cpu_ms_frame (CPU time of the
+/// calling thread in Backend::render), ms_device (device timestamps; Vulkan only), working_set_MiB,
+/// samples_per_ray, nodes_per_ray, bricks_touched.
 FrameAverages run_frames(benchmark::State& state, Rig& rig, const std::vector<FrameTables>& tables);
 
 }  // namespace resoct::bench

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
+
+#include <glm/geometric.hpp>
 
 #include "resoct/camera.hpp"
 #include "resoct/error.hpp"
@@ -78,6 +81,30 @@ std::uint32_t check_extent(std::uint64_t v, const char* name) {
   return std::uint32_t(v);
 }
 
+// Finest level the per-sample LOD choice (kernel/step.glsl.h) can select anywhere in the volume
+// this frame. The pixel footprint grows with view depth and view depth is linear, so the volume
+// corner nearest in depth bounds it. A 1e-3 relative margin keeps the kernel's float rounding
+// from choosing one level finer at that corner.
+std::uint32_t lod_floor_level(const Scene& scene, const BrickHierarchy& h) {
+  const CameraRays rays(scene.camera, scene.viewport);
+  const glm::dvec3 ext = box_extent(h.volume());
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const glm::dvec3 corner((c & 1) ? ext.x : 0.0, (c & 2) ? ext.y : 0.0, (c & 4) ? ext.z : 0.0);
+    nearest = std::min(nearest, glm::dot(corner - scene.camera.eye, rays.forward()));
+  }
+  const double allowed = rays.footprint(nearest) * scene.lod_error_px * (1.0 - 1e-3);
+  if (!(allowed > 0.0) || !std::isfinite(allowed)) return 0;
+  const double budget = std::log2(allowed);
+  const std::vector<float> sizes = level_size_log2_table(h);
+  std::uint32_t level = 0;
+  for (std::uint32_t l = 1; l < sizes.size(); ++l) {
+    if (double(sizes[l]) > budget) break;
+    level = l;
+  }
+  return level;
+}
+
 }  // namespace
 
 void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
@@ -140,6 +167,11 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
 
   out.slots.clear();
   out.tf_luts.assign(std::size_t(channels.slot_count()) * kTfLutSize, glm::vec4(0.0f));
+  // The step (Eq. 8.2-8.3) follows the finest level any sample of a channel can use: its finest
+  // allowed level, or the level the LOD picks at the volume's nearest point when that is
+  // coarser. Without the LOD floor a distant view of a huge volume would march level-0 steps
+  // through coarse data, so samples per ray would grow with the data instead of the screen.
+  const std::uint32_t lod_floor = lod_floor_level(scene, hierarchy);
   glm::dvec3 finest_voxel(std::numeric_limits<double>::infinity());
   for (std::uint32_t i : order) {
     const ChannelSettings& c = scene.channels[i];
@@ -168,7 +200,9 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
 
     const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
     std::copy(lut.begin(), lut.end(), out.tf_luts.begin() + std::ptrdiff_t(*slot) * kTfLutSize);
-    finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, s.finest_level));
+    const std::uint32_t step_level =
+        std::min(std::max(lod_floor, s.finest_level), s.coarsest_level);
+    finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, step_level));
   }
   if (scene.channels.empty()) finest_voxel = box_voxel_size(volume);
 
