@@ -100,8 +100,15 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
     // As in teem, byte skip applies to the decompressed data of compressed encodings.
     std::vector<std::byte> packed(std::size_t(data.size() - std::min(data.size(), start)));
     data.read_at(start, packed);
-    std::vector<std::byte> all(std::size_t(std::uint64_t(h.byte_skip) + need));
-    detail::inflate_exact(packed, all, detail::Deflate::any, data.path());
+    // The buffer grows with the decoded data, so a header announcing more than the stream holds
+    // fails as truncated instead of allocating the announced size up front.
+    const std::uint64_t want = std::uint64_t(h.byte_skip) + need;
+    std::vector<std::byte> all = detail::inflate_all(packed, want, data.path(), true);
+    if (all.size() != want) {
+      throw file_error(ErrorCode::truncated, data.path(), start,
+                       "gzip data holds " + std::to_string(all.size()) + " bytes, the header " +
+                           "announces " + std::to_string(want));
+    }
     stored.assign(all.begin() + std::ptrdiff_t(h.byte_skip), all.end());
   } else {
     std::uint64_t offset = start + std::uint64_t(std::max<std::int64_t>(h.byte_skip, 0));

@@ -34,6 +34,8 @@ int ignore(TIFF*, void*, const char*, const char*, va_list) {
 class TiffFile {
  public:
   explicit TiffFile(const std::string& path) : path_(path) {
+    std::error_code ec;
+    bytes_ = std::filesystem::file_size(path, ec);
     TIFFOpenOptions* o = TIFFOpenOptionsAlloc();
     TIFFOpenOptionsSetErrorHandlerExtR(o, capture, &message_);
     TIFFOpenOptionsSetWarningHandlerExtR(o, ignore, nullptr);
@@ -51,10 +53,15 @@ class TiffFile {
   TIFF* get() const noexcept { return tif_; }
   const std::string& path() const noexcept { return path_; }
   std::string message() const { return message_.empty() ? "" : " (" + message_ + ")"; }
+  /// Most pixel bytes a page of this file can decode to: no TIFF codec expands beyond 4096:1
+  /// (LZW's longest string per 12-bit code), so larger claims are corrupt, and are rejected
+  /// before anything is allocated for them.
+  std::uint64_t max_page_bytes() const noexcept { return bytes_ * 4096 + (1u << 20); }
 
  private:
   std::string path_;
   std::string message_;
+  std::uint64_t bytes_ = 0;
   TIFF* tif_ = nullptr;
 };
 
@@ -97,12 +104,16 @@ void read_page(const TiffFile& f, const PageFormat& p, std::uint64_t page,
   TIFF* t = f.get();
   const std::size_t vs = p.bits / 8u;
   const std::size_t row = std::size_t(p.width) * vs;
-  const std::size_t base = out.size();
-  out.resize(base + row * p.height);
   auto fail = [&](const std::string& what) {
     return file_error(ErrorCode::corrupt, f.path(), 0,
                       "page " + std::to_string(page) + ": " + what + f.message());
   };
+  if (std::uint64_t(row) * p.height > f.max_page_bytes()) {
+    throw fail(std::to_string(p.width) + "x" + std::to_string(p.height) +
+               " pixels cannot be held by a file of this size");
+  }
+  const std::size_t base = out.size();
+  out.resize(base + row * p.height);
   if (TIFFIsTiled(t) != 0) {
     std::uint32_t tw = 0, th = 0;
     TIFFGetField(t, TIFFTAG_TILEWIDTH, &tw);
