@@ -379,6 +379,91 @@ void zarr_chunk_seeds(std::vector<Seed>& out) {
   }
 }
 
+// One entry of the ome_zarr target's in-memory store: KEY '\n' LENGTH '\n' BYTES.
+void store_entry(std::vector<std::byte>& archive, const std::string& key,
+                 const std::vector<std::byte>& bytes) {
+  const std::vector<std::byte> head = text_bytes(key + "\n" + std::to_string(bytes.size()) + "\n");
+  archive.insert(archive.end(), head.begin(), head.end());
+  archive.insert(archive.end(), bytes.begin(), bytes.end());
+}
+
+// Chunk voxels of a little-endian array: value = (index * 37 + chunk * 11) % modulus.
+std::vector<std::byte> chunk_voxels(std::size_t voxels, std::size_t width, int chunk, int modulus) {
+  std::vector<std::byte> b;
+  for (std::size_t i = 0; i < voxels; ++i) {
+    const auto v = std::uint32_t((int(i) * 37 + chunk * 11) % modulus);
+    if (width == 4) {
+      const float f = float(v) / float(modulus);
+      std::uint32_t bits;
+      std::memcpy(&bits, &f, 4);
+      for (int k = 3; k >= 0; --k) b.push_back(std::byte((bits >> (8 * k)) & 0xFF));  // ">f4"
+    } else {
+      for (std::size_t k = 0; k < width; ++k) b.push_back(std::byte((v >> (8 * k)) & 0xFF));
+    }
+  }
+  return b;
+}
+
+void ome_zarr_seeds(std::vector<Seed>& out) {
+  {
+    // czyx u16, zstd, two datasets; some chunks missing (fill value 7).
+    std::vector<std::byte> a;
+    store_entry(a, ".zattrs", text_bytes(R"({"multiscales": [{"version": "0.4",
+ "axes": [{"name": "c", "type": "channel"}, {"name": "z", "type": "space"},
+          {"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+ "datasets": [
+  {"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1, 2, 1, 1]}]},
+  {"path": "1", "coordinateTransformations": [{"type": "scale", "scale": [1, 2, 2, 2]}]}]}]})"));
+    store_entry(a, "0/.zarray", text_bytes(R"({"zarr_format": 2, "shape": [2, 5, 10, 12],
+ "chunks": [1, 5, 8, 8], "dtype": "<u2", "order": "C", "compressor": {"id": "zstd"},
+ "fill_value": 7, "filters": null})"));
+    store_entry(a, "1/.zarray", text_bytes(R"({"zarr_format": 2, "shape": [2, 5, 5, 6],
+ "chunks": [1, 5, 5, 6], "dtype": "<u2", "order": "C", "compressor": null,
+ "fill_value": 7, "filters": null})"));
+    int n = 0;
+    for (const char* key : {"0/0.0.0.0", "0/0.0.1.1", "0/1.0.0.1", "0/1.0.1.0"}) {
+      store_entry(a, key, compress(Codec::zstd, 0, chunk_voxels(320, 2, n++, 4000)));
+    }
+    store_entry(a, "1/0.0.0.0", chunk_voxels(150, 2, 9, 4000));
+    out.push_back({"ome_zarr", "seed-czyx-u16-zstd.store", a, false});
+  }
+  {
+    // A bare root array, zyx u8, uncompressed, '/' separated chunk keys.
+    std::vector<std::byte> a;
+    store_entry(a, ".zarray", text_bytes(R"({"zarr_format": 2, "shape": [5, 6, 7],
+ "chunks": [3, 3, 4], "dtype": "|u1", "order": "C", "compressor": null, "fill_value": 3,
+ "dimension_separator": "/"})"));
+    int n = 0;
+    for (const char* key : {"0/0/0", "0/1/1", "1/0/1"}) {
+      store_entry(a, key, chunk_voxels(36, 1, n++, 256));
+    }
+    out.push_back({"ome_zarr", "seed-bare-zyx-u8.store", a});
+  }
+  {
+    // yx big-endian f32 in blosc, with an omero window (the value range).
+    std::vector<std::byte> a;
+    store_entry(a, ".zattrs", text_bytes(R"({"multiscales": [{"version": "0.4", "name": "yx",
+ "axes": [{"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+ "datasets": [{"path": "s0", "coordinateTransformations": [{"type": "scale",
+   "scale": [0.5, 0.5]}]}]}],
+ "omero": {"channels": [{"label": "f", "color": "FFFFFF", "window": {"start": 0, "end": 1}}]}})"));
+    store_entry(a, "s0/.zarray", text_bytes(R"({"zarr_format": 2, "shape": [9, 10],
+ "chunks": [4, 4], "dtype": ">f4", "order": "C", "compressor": {"id": "blosc", "cname": "lz4",
+ "clevel": 5, "shuffle": 1}, "fill_value": "NaN", "filters": null})"));
+    int n = 0;
+    for (const char* key : {"s0/0.0", "s0/1.2", "s0/2.1"}) {
+      const std::vector<std::byte> raw = chunk_voxels(16, 4, n++, 100);
+      std::vector<std::byte> enc(raw.size() + BLOSC_MAX_OVERHEAD);
+      const int m = blosc_compress_ctx(5, BLOSC_SHUFFLE, 4, raw.size(), raw.data(), enc.data(),
+                                       enc.size(), "lz4", 0, 1);
+      if (m <= 0) throw std::runtime_error("blosc compression failed");
+      enc.resize(std::size_t(m));
+      store_entry(a, key, enc);
+    }
+    out.push_back({"ome_zarr", "seed-yx-f32-blosc.store", a, false});
+  }
+}
+
 std::vector<Seed> all_seeds(const fs::path& scratch) {
   std::vector<Seed> s;
   store_seeds(scratch / "stores", s);
@@ -390,6 +475,7 @@ std::vector<Seed> all_seeds(const fs::path& scratch) {
   ome_seeds(s);
   nifti_seeds(s);
   nrrd_seeds(s);
+  ome_zarr_seeds(s);
   return s;
 }
 
