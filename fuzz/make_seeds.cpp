@@ -23,6 +23,7 @@
 #include "resoct/brick_store.hpp"
 #include "resoct/codec.hpp"
 #include "resoct/dense_volume.hpp"
+#include "resoct/image.hpp"
 #include "resoct/in_memory_source.hpp"
 #include "resoct/scene.hpp"
 
@@ -464,6 +465,23 @@ void ome_zarr_seeds(std::vector<Seed>& out) {
   }
 }
 
+void png_seeds(const fs::path& scratch, std::vector<Seed>& out) {
+  fs::create_directories(scratch);
+  const glm::uvec2 sizes[] = {{1, 1}, {7, 3}, {16, 16}};
+  for (const glm::uvec2 s : sizes) {
+    Image img(s.x, s.y);
+    for (std::uint32_t y = 0; y < s.y; ++y) {
+      for (std::uint32_t x = 0; x < s.x; ++x) {
+        img.at(x, y) = glm::vec4(float(x) / float(s.x), float(y) / float(s.y),
+                                 float((x + y) % 3) / 2.0f, (x % 2) != 0 ? 1.0f : 0.5f);
+      }
+    }
+    const std::string name = "seed-" + std::to_string(s.x) + "x" + std::to_string(s.y) + ".png";
+    write_png(img, (scratch / name).string());
+    out.push_back({"png", name, file_bytes(scratch / name), false});
+  }
+}
+
 std::vector<Seed> all_seeds(const fs::path& scratch) {
   std::vector<Seed> s;
   store_seeds(scratch / "stores", s);
@@ -476,6 +494,7 @@ std::vector<Seed> all_seeds(const fs::path& scratch) {
   nifti_seeds(s);
   nrrd_seeds(s);
   ome_zarr_seeds(s);
+  png_seeds(scratch / "png", s);
   return s;
 }
 
