@@ -10,9 +10,12 @@
 namespace resoct::fuzz {
 
 ScratchFile::ScratchFile(const char* stem) {
-  const char* dir = std::getenv("TMPDIR");
-  std::string pattern =
-      std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/" + stem + "-XXXXXX";
+  // Memory-backed /dev/shm when TMPDIR does not say otherwise: the brick store target rewrites
+  // the file for every input and runs about 3x faster there than on a disk-backed /tmp.
+  const char* env = std::getenv("TMPDIR");
+  std::string dir = env != nullptr && *env != '\0' ? env : "/tmp";
+  if (env == nullptr && ::access("/dev/shm", W_OK) == 0) dir = "/dev/shm";
+  std::string pattern = dir + "/" + stem + "-XXXXXX";
   std::vector<char> buf(pattern.begin(), pattern.end());
   buf.push_back('\0');
   fd_ = ::mkstemp(buf.data());

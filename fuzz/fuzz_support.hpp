@@ -42,7 +42,8 @@ bool errors_only(F&& f) {
   }
 }
 
-/// One temporary file per process, rewritten with each input (for readers that take a path).
+/// One temporary file per process (in $TMPDIR, else /dev/shm, else /tmp), rewritten with each
+/// input (for readers that take a path).
 class ScratchFile {
  public:
   explicit ScratchFile(const char* stem);
