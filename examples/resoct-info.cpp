@@ -1,5 +1,5 @@
-// resoct-info: prints the hierarchy of a brick store or a procedural source, with per-level
-// storage numbers for stores; --json emits the same as JSON. See docs/tools.md.
+// resoct-info: prints the hierarchy of a brick store, a procedural source or a volume file, with
+// per-level storage numbers for stores; --json emits the same as JSON. See docs/tools.md.
 
 #include <cmath>
 #include <cstdio>
@@ -66,13 +66,13 @@ json level_json(const BrickHierarchy& h, std::uint32_t l, const StoreStats* stat
   return j;
 }
 
-json describe(const BrickSource& src, const BrickStoreSource* store) {
+json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind kind) {
   const BrickHierarchy& h = src.hierarchy();
   const VolumeDesc& v = h.volume();
   const StoreStats* stats = store != nullptr ? &store->stats() : nullptr;
   json j;
   j["source"] = src.name();
-  j["kind"] = store != nullptr ? "store" : "procedural";
+  j["kind"] = std::string(to_string(kind));
   json ranges = json::array();
   for (std::uint32_t c = 0; c < v.channels; ++c) {
     ranges.push_back(json::array({v.range(c).lo, v.range(c).hi}));
@@ -132,7 +132,7 @@ std::string ranges_text(const VolumeDesc& v) {
   return s;
 }
 
-void print_text(const BrickSource& src, const BrickStoreSource* store) {
+void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKind kind) {
   const BrickHierarchy& h = src.hierarchy();
   const VolumeDesc& v = h.volume();
   const BrickLayout& lay = h.layout();
@@ -151,10 +151,13 @@ void print_text(const BrickSource& src, const BrickStoreSource* store) {
                 std::string(to_string(stats->codec)).c_str(), stats->codec_level,
                 stats->format_version, store->metadata_block(),
                 format_bytes(stats->file_bytes).c_str());
-  } else {
+  } else if (kind == SourceKind::procedural) {
     std::printf(
         "  (procedural source: bricks are computed on demand, nothing is stored; "
         "hierarchy only)\n");
+  } else {
+    std::printf("  (%s source: coarser levels are built on demand; hierarchy only)\n",
+                std::string(to_string(kind)).c_str());
   }
   std::printf("\n%-5s %-17s %-9s %-11s %9s", "level", "extent", "factor", "bricks", "count");
   if (stats != nullptr) {
@@ -203,10 +206,11 @@ void print_text(const BrickSource& src, const BrickStoreSource* store) {
 int info(const std::string& spec, bool as_json) {
   const std::unique_ptr<BrickSource> src = open_source(spec);
   const auto* store = dynamic_cast<const BrickStoreSource*>(src.get());
+  const SourceKind kind = detect_source_kind(spec);
   if (as_json) {
-    std::printf("%s\n", describe(*src, store).dump(2).c_str());
+    std::printf("%s\n", describe(*src, store, kind).dump(2).c_str());
   } else {
-    print_text(*src, store);
+    print_text(*src, store, kind);
   }
   return 0;
 }
@@ -216,7 +220,7 @@ int info(const std::string& spec, bool as_json) {
 int main(int argc, char** argv) {
   CLI::App app{
       "Prints the resolution levels, bricks and storage numbers of a resoct brick store "
-      "or a procedural source."};
+      "a procedural source or a volume file (OME-Zarr, NIfTI, NRRD, TIFF)."};
   one_line_usage_errors(app, kTool);
   std::string spec;
   bool as_json = false;

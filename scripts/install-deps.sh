@@ -11,6 +11,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libpng-dev libcli11-dev libcurl4-openssl-dev libblosc-dev libtiff-dev
   python3-matplotlib
+  # formats tests: OME-Zarr written by the reference implementation, real MRI volumes
+  python3-zarr python3-numcodecs python3-numpy mricron-data
 )
 
 missing=()

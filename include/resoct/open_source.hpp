@@ -30,6 +30,9 @@ enum class SourceKind {
   stack,
 };
 
+/// "unknown", "procedural", "store", "ome-zarr", "nifti", "nrrd", "tiff", "stack".
+std::string_view to_string(SourceKind k) noexcept;
+
 /// Classifies `spec` without opening it as a source (a brick store's first bytes are read).
 /// A path that does not exist is `unknown`. Thread-safety: a pure function.
 SourceKind detect_source_kind(std::string_view spec);

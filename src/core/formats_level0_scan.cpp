@@ -85,9 +85,19 @@ void tile_minmax(std::span<const std::byte> voxels, double& lo, double& hi) {
   }
 }
 
+/// Integer types: the occupancy bit of every possible value, looked up instead of recomputed.
+std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r) {
+  std::vector<std::uint32_t> lut;
+  if (t == VoxelType::f32) return lut;
+  lut.resize(t == VoxelType::u8 ? 256u : 65536u);
+  for (std::size_t v = 0; v < lut.size(); ++v) lut[v] = occupancy_bit(double(v), r);
+  return lut;
+}
+
 template <typename T>
 void tile_metadata(const Box3& box, std::span<const std::byte> voxels, const ValueRange& r,
-                   std::uint32_t channel, MetadataPyramid& pyramid) {
+                   const std::vector<std::uint32_t>& lut, std::uint32_t channel,
+                   MetadataPyramid& pyramid) {
   const auto bs = std::int64_t(pyramid.block_size());
   const glm::i64vec3 s = box.size();
   const glm::i64vec3 b0 = box.lo / bs, b1 = (box.hi - std::int64_t(1)) / bs;
@@ -97,14 +107,24 @@ void tile_metadata(const Box3& box, std::span<const std::byte> voxels, const Val
     for (std::int64_t y = 0; y < s.y; ++y) {
       const std::size_t row = std::size_t((z * s.y + y) * s.x);
       const std::int64_t by = (box.lo.y + y) / bs - b0.y, bz = (box.lo.z + z) / bs - b0.z;
-      for (std::int64_t x = 0; x < s.x; ++x) {
-        const double d = value_at<T>(voxels.data(), row + std::size_t(x));
-        if (std::isnan(d)) continue;
-        const std::int64_t bx = (box.lo.x + x) / bs - b0.x;
+      // One run of x per metadata block, so the block index is not divided out per voxel.
+      for (std::int64_t bx = 0; bx < nb.x; ++bx) {
         RegionMeta& m = meta[std::size_t((bz * nb.y + by) * nb.x + bx)];
-        m.min = std::min(m.min, d);
-        m.max = std::max(m.max, d);
-        m.occupancy |= occupancy_bit(d, r);
+        const std::int64_t x0 = std::max<std::int64_t>(0, (b0.x + bx) * bs - box.lo.x);
+        const std::int64_t x1 = std::min<std::int64_t>(s.x, (b0.x + bx + 1) * bs - box.lo.x);
+        for (std::int64_t x = x0; x < x1; ++x) {
+          T v;
+          std::memcpy(&v, voxels.data() + (row + std::size_t(x)) * sizeof(T), sizeof(T));
+          const double d = double(v);
+          if constexpr (std::is_same_v<T, float>) {
+            if (std::isnan(d)) continue;
+            m.occupancy |= occupancy_bit(d, r);
+          } else {
+            m.occupancy |= lut[std::size_t(v)];
+          }
+          m.min = std::min(m.min, d);
+          m.max = std::max(m.max, d);
+        }
       }
     }
   }
@@ -147,13 +167,22 @@ std::vector<std::pair<double, double>> scan_finite_minmax(const VolumeDesc& desc
 
 void fill_metadata(const VolumeDesc& desc, const LevelBoxReader& level0, MetadataPyramid& pyramid,
                    std::uint32_t threads) {
+  std::vector<std::vector<std::uint32_t>> luts;
+  for (std::uint32_t c = 0; c < desc.channels; ++c) {
+    luts.push_back(occupancy_lut(desc.type, desc.range(c)));
+  }
   for_each_tile(desc, level0, tile_edge(pyramid.block_size()), threads,
                 [&](const Box3& box, std::uint32_t c, std::span<const std::byte> v) {
                   const ValueRange r = desc.range(c);
+                  const auto& lut = luts[c];
                   switch (desc.type) {
-                    case VoxelType::u8: tile_metadata<std::uint8_t>(box, v, r, c, pyramid); break;
-                    case VoxelType::u16: tile_metadata<std::uint16_t>(box, v, r, c, pyramid); break;
-                    case VoxelType::f32: tile_metadata<float>(box, v, r, c, pyramid); break;
+                    case VoxelType::u8:
+                      tile_metadata<std::uint8_t>(box, v, r, lut, c, pyramid);
+                      break;
+                    case VoxelType::u16:
+                      tile_metadata<std::uint16_t>(box, v, r, lut, c, pyramid);
+                      break;
+                    case VoxelType::f32: tile_metadata<float>(box, v, r, lut, c, pyramid); break;
                   }
                 });
   pyramid.build();

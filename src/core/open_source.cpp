@@ -96,6 +96,20 @@ std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout
 
 }  // namespace
 
+std::string_view to_string(SourceKind k) noexcept {
+  switch (k) {
+    case SourceKind::unknown: return "unknown";
+    case SourceKind::procedural: return "procedural";
+    case SourceKind::brick_store: return "store";
+    case SourceKind::ome_zarr: return "ome-zarr";
+    case SourceKind::nifti: return "nifti";
+    case SourceKind::nrrd: return "nrrd";
+    case SourceKind::tiff: return "tiff";
+    case SourceKind::stack: return "stack";
+  }
+  return "unknown";
+}
+
 SourceKind detect_source_kind(std::string_view spec) {
   if (spec.starts_with(kProceduralPrefix)) return SourceKind::procedural;
   if (spec.starts_with(kStackPrefix)) return SourceKind::stack;
