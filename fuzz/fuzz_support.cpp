@@ -9,6 +9,23 @@
 
 namespace resoct::fuzz {
 
+void exercise_source(const BrickSource& src, std::uint64_t max_bricks) {
+  const BrickHierarchy& h = src.hierarchy();
+  const VolumeDesc& v = h.volume();
+  std::vector<std::byte> buf(std::size_t(h.layout().padded_voxels()) * voxel_size(v.type));
+  const Box3 all{glm::i64vec3(0), glm::i64vec3(v.extent)};
+  for (std::uint32_t c = 0; c < v.channels && c < 4; ++c) {
+    for (std::uint64_t i = 0; i < h.bricks_per_channel() && i < max_bricks; ++i) {
+      const BrickKey key = h.key_from_linear(c, i);
+      errors_only([&] {
+        src.read_brick(key, buf);
+        (void)src.brick_meta(key);
+      });
+    }
+    (void)src.region_meta(c, all);
+  }
+}
+
 ScratchFile::ScratchFile(const char* stem) {
   // Memory-backed /dev/shm when TMPDIR does not say otherwise: the brick store target rewrites
   // the file for every input and runs about 3x faster there than on a disk-backed /tmp.

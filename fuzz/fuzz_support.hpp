@@ -10,6 +10,7 @@
 #include <exception>
 #include <string_view>
 
+#include "resoct/brick_source.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct::fuzz {
@@ -41,6 +42,11 @@ bool errors_only(F&& f) {
     fail("non-standard exception");
   }
 }
+
+/// Reads up to `max_bricks` bricks of each of the first four channels (each read may throw
+/// resoct::Error, which only skips that brick), their metadata, and the region metadata of the
+/// whole volume: what a renderer asks of a freshly opened source.
+void exercise_source(const BrickSource& src, std::uint64_t max_bricks);
 
 /// One temporary file per process (in $TMPDIR, else /dev/shm, else /tmp), rewritten with each
 /// input (for readers that take a path).

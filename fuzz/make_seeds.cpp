@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <blosc.h>
+#include <tiffio.h>
 #include <zlib.h>
 
 #include "resoct/brick_store.hpp"
@@ -482,6 +483,119 @@ void png_seeds(const fs::path& scratch, std::vector<Seed>& out) {
   }
 }
 
+void nifti_file_seeds(std::vector<Seed>& out) {
+  NiftiFields a;
+  a.dim[1] = 4, a.dim[2] = 4, a.dim[3] = 2;
+  std::vector<std::byte> fa = nifti(a);
+  for (int i = 0; i < 32; ++i) fa.push_back(std::byte(i * 7));
+  out.push_back({"nifti_file", "seed-u8-4x4x2.nii", fa});
+  out.push_back({"nifti_file", "seed-u8-4x4x2.nii.gz", deflate(fa, true), false});
+  NiftiFields b;
+  b.big = true;
+  b.dim[0] = 4, b.dim[1] = 3, b.dim[2] = 3, b.dim[3] = 2, b.dim[4] = 2;
+  b.datatype = 4, b.bitpix = 16;
+  b.slope = 2.0f, b.inter = -100.0f;
+  std::vector<std::byte> fb = nifti(b);
+  for (int i = 0; i < 36; ++i) {
+    const auto v = std::int16_t(i * 300 - 5000);
+    fb.push_back(std::byte((std::uint16_t(v) >> 8) & 0xFF));
+    fb.push_back(std::byte(std::uint16_t(v) & 0xFF));
+  }
+  out.push_back({"nifti_file", "seed-i16-be-scaled-2vol.nii", fb});
+  NiftiFields c;
+  c.dim[1] = 5, c.dim[2] = 2, c.dim[3] = 1;
+  c.datatype = 16, c.bitpix = 32;
+  std::vector<std::byte> fc = nifti(c);
+  for (int i = 0; i < 10; ++i) {
+    const float f = i == 3 ? std::numeric_limits<float>::quiet_NaN() : float(i) * 0.25f;
+    std::byte raw[4];
+    std::memcpy(raw, &f, 4);
+    fc.insert(fc.end(), raw, raw + 4);
+  }
+  out.push_back({"nifti_file", "seed-f32-nan.nii", fc});
+}
+
+void nrrd_file_seeds(std::vector<Seed>& out) {
+  std::vector<std::byte> a = text_bytes(
+      "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4 3 2\nencoding: raw\n"
+      "spacings: 1 1 3\n\n");
+  for (int i = 0; i < 24; ++i) a.push_back(std::byte(i * 10));
+  out.push_back({"nrrd_file", "seed-u8-raw.nrrd", a});
+  std::vector<std::byte> floats;
+  for (int i = 0; i < 36; ++i) {
+    const float f = float(i) / 8.0f;
+    std::uint32_t bits;
+    std::memcpy(&bits, &f, 4);
+    for (int k = 3; k >= 0; --k) floats.push_back(std::byte((bits >> (8 * k)) & 0xFF));
+  }
+  std::vector<std::byte> b = text_bytes(
+      "NRRD0005\ntype: float\ndimension: 4\nsizes: 2 3 3 2\n"
+      "kinds: vector domain domain domain\nendian: big\nencoding: gzip\n"
+      "space directions: none (0.5,0,0) (0,0.5,0) (0,0,2)\n\n");
+  const std::vector<std::byte> gz = deflate(floats, true);
+  b.insert(b.end(), gz.begin(), gz.end());
+  out.push_back({"nrrd_file", "seed-f32-gzip-vector.nrrd", b, false});
+  std::vector<std::byte> c = text_bytes(
+      "NRRD0004\ntype: ushort\ndimension: 4\nsizes: 3 2 2 2\n"
+      "kinds: domain domain domain list\nendian: little\nencoding: raw\nbyte skip: -1\n\n"
+      "padding before the data\n");
+  for (int i = 0; i < 24; ++i) {
+    c.push_back(std::byte((i * 999) & 0xFF));
+    c.push_back(std::byte((i * 999) >> 8));
+  }
+  out.push_back({"nrrd_file", "seed-u16-list-byteskip.nrrd", c});
+}
+
+// A multi-page TIFF through libtiff itself (strips, optional deflate), one page per z slice.
+std::vector<std::byte> tiff_file(const fs::path& path, std::uint32_t w, std::uint32_t h,
+                                 std::uint32_t pages, int bits, int format, bool deflate) {
+  TIFF* t = TIFFOpen(path.c_str(), "w");
+  if (t == nullptr) throw std::runtime_error("TIFFOpen failed");
+  const std::size_t bytes = std::size_t(bits / 8);
+  for (std::uint32_t p = 0; p < pages; ++p) {
+    TIFFSetField(t, TIFFTAG_IMAGEWIDTH, w);
+    TIFFSetField(t, TIFFTAG_IMAGELENGTH, h);
+    TIFFSetField(t, TIFFTAG_BITSPERSAMPLE, bits);
+    TIFFSetField(t, TIFFTAG_SAMPLESPERPIXEL, 1);
+    TIFFSetField(t, TIFFTAG_SAMPLEFORMAT, format);
+    TIFFSetField(t, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+    TIFFSetField(t, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+    TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, 2);
+    TIFFSetField(t, TIFFTAG_COMPRESSION, deflate ? COMPRESSION_ADOBE_DEFLATE : COMPRESSION_NONE);
+    if (pages > 1) {
+      TIFFSetField(t, TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
+      TIFFSetField(t, TIFFTAG_PAGENUMBER, p, pages);
+    }
+    std::vector<std::byte> row(w * bytes);
+    for (std::uint32_t y = 0; y < h; ++y) {
+      for (std::uint32_t x = 0; x < w; ++x) {
+        const std::uint32_t v = (x * 13 + y * 7 + p * 29) % 200;
+        if (format == SAMPLEFORMAT_IEEEFP) {
+          const float f = float(v) / 200.0f;
+          std::memcpy(row.data() + x * 4, &f, 4);
+        } else {
+          for (std::size_t k = 0; k < bytes; ++k)
+            row[x * bytes + k] = std::byte((v >> (8 * k)) & 0xFF);
+        }
+      }
+      if (TIFFWriteScanline(t, row.data(), y, 0) < 0) throw std::runtime_error("TIFF write failed");
+    }
+    TIFFWriteDirectory(t);
+  }
+  TIFFClose(t);
+  return file_bytes(path);
+}
+
+void tiff_seeds(const fs::path& scratch, std::vector<Seed>& out) {
+  fs::create_directories(scratch);
+  out.push_back({"tiff_file", "seed-u8-3pages.tif",
+                 tiff_file(scratch / "a.tif", 6, 5, 3, 8, SAMPLEFORMAT_UINT, false), false});
+  out.push_back({"tiff_file", "seed-u16-deflate.tif",
+                 tiff_file(scratch / "b.tif", 9, 4, 2, 16, SAMPLEFORMAT_UINT, true), false});
+  out.push_back({"tiff_file", "seed-f32.tif",
+                 tiff_file(scratch / "c.tif", 4, 4, 1, 32, SAMPLEFORMAT_IEEEFP, false), false});
+}
+
 std::vector<Seed> all_seeds(const fs::path& scratch) {
   std::vector<Seed> s;
   store_seeds(scratch / "stores", s);
@@ -495,6 +609,9 @@ std::vector<Seed> all_seeds(const fs::path& scratch) {
   nrrd_seeds(s);
   ome_zarr_seeds(s);
   png_seeds(scratch / "png", s);
+  nifti_file_seeds(s);
+  nrrd_file_seeds(s);
+  tiff_seeds(scratch / "tiff", s);
   return s;
 }
 

@@ -100,7 +100,18 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
     // As in teem, byte skip applies to the decompressed data of compressed encodings.
     std::vector<std::byte> packed(std::size_t(data.size() - std::min(data.size(), start)));
     data.read_at(start, packed);
-    std::vector<std::byte> all(std::size_t(std::uint64_t(h.byte_skip) + need));
+    // Deflate expands at most 1032:1, so a header announcing more than the packed bytes can
+    // hold is cut short. Checking before allocating keeps an 80-byte file from allocating the
+    // announced size (which threw std::bad_alloc), and the skip + size sum from wrapping.
+    const std::uint64_t skip = std::uint64_t(h.byte_skip);
+    const std::uint64_t max_out = std::uint64_t(packed.size()) * 1032 + 64;
+    if (skip > max_out || need > max_out - skip) {
+      throw file_error(ErrorCode::truncated, data.path(), start,
+                       "gzip data of " + std::to_string(packed.size()) + " bytes cannot hold " +
+                           std::to_string(need) + " data bytes after skipping " +
+                           std::to_string(skip));
+    }
+    std::vector<std::byte> all(std::size_t(skip + need));
     detail::inflate_exact(packed, all, detail::Deflate::any, data.path());
     stored.assign(all.begin() + std::ptrdiff_t(h.byte_skip), all.end());
   } else {
