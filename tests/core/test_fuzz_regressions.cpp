@@ -1,0 +1,40 @@
+// Crashes the fuzzers found (fuzz/regressions/), each pinned to the resoct::Error it must now
+// raise. The replay tests (fuzz_replay.*) only assert "no crash"; these also fix the error class
+// and that the message names the file, so a later change cannot turn the fix into another
+// failure mode unnoticed.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "resoct/formats/nrrd.hpp"
+#include "resoct/image.hpp"
+#include "support/expect_error.hpp"
+
+using namespace resoct;
+
+namespace {
+
+std::string regression(const std::string& target, const std::string& name) {
+  return std::string(RESOCT_SOURCE_DIR) + "/fuzz/regressions/" + target + "/" + name;
+}
+
+}  // namespace
+
+TEST(FuzzRegressions, PngHeaderAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
+  // 83 bytes announcing 30000x30000 pixels: read_png allocated and cleared 3.5 GB before
+  // libpng found the data missing (or threw std::bad_alloc under a memory limit).
+  const std::string path = regression("png", "ihdr-30000x30000-in-83-bytes.png");
+  EXPECT_RESOCT_ERROR(read_png(path), ErrorCode::corrupt, "30000x30000 image cannot be stored");
+  EXPECT_RESOCT_ERROR(read_png(path), ErrorCode::corrupt, path);
+}
+
+TEST(FuzzRegressions, NrrdGzipAnnouncingMoreThanDeflateCanHoldIsTruncated) {
+  // 79 bytes of header and gzip announcing 10^15 (and 10^9) voxels: open_nrrd allocated the
+  // announced size before inflating (std::bad_alloc, or a gigabyte per file).
+  for (const char* name : {"gzip-announces-1e15-bytes.nrrd", "gzip-announces-1e9-bytes.nrrd"}) {
+    const std::string path = regression("nrrd_file", name);
+    EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, "cannot hold");
+    EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, path);
+  }
+}
