@@ -8,6 +8,7 @@
 #include <string>
 
 #include "resoct/formats/nrrd.hpp"
+#include "resoct/formats/tiff_stack.hpp"
 #include "resoct/image.hpp"
 #include "support/expect_error.hpp"
 
@@ -37,4 +38,13 @@ TEST(FuzzRegressions, NrrdGzipAnnouncingMoreThanDeflateCanHoldIsTruncated) {
     EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, "cannot hold");
     EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, path);
   }
+}
+
+TEST(FuzzRegressions, TiffPageAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
+  // 638 bytes whose first page claims 65535x65535 pixels: open_tiff_stack allocated and cleared
+  // 4.2 GB before libtiff failed to read the strips.
+  const std::string path = regression("tiff_file", "65535x65535-in-638-bytes.tif");
+  EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt,
+                      "65535x65535 pixels cannot be stored");
+  EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt, path);
 }
