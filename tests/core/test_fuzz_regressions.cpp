@@ -10,6 +10,7 @@
 #include "resoct/formats/nrrd.hpp"
 #include "resoct/formats/tiff_stack.hpp"
 #include "resoct/image.hpp"
+#include "resoct/scene.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;
@@ -47,4 +48,14 @@ TEST(FuzzRegressions, TiffPageAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
   EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt,
                       "65535x65535 pixels cannot be stored");
   EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt, path);
+}
+
+TEST(FuzzRegressions, SceneNumberBeyondDoubleRangeIsMalformedJson) {
+  // nlohmann::json reports "1e3080" as out_of_range, not parse_error; parse_scene let that
+  // escape as a foreign exception.
+  EXPECT_RESOCT_ERROR(parse_scene(R"({"camera": {"eye": [1e3080, 0, 0]}})", "s.json"),
+                      ErrorCode::corrupt, "s.json: malformed JSON");
+  EXPECT_RESOCT_ERROR(
+      load_scene(regression("scene_json", "number-literal-1e3080-out-of-range.json")),
+      ErrorCode::corrupt, "number overflow");
 }
