@@ -103,13 +103,14 @@ void inflate_exact(std::span<const std::byte> in, std::span<std::byte> out, Defl
 }
 
 std::vector<std::byte> inflate_all(std::span<const std::byte> in, std::uint64_t max_bytes,
-                                   std::string_view location) {
+                                   std::string_view location, bool stop_at_max) {
   Inflater z(Deflate::any, location);
   std::vector<std::byte> out;
   std::size_t used = 0;
   bool ended = false;
   while (!ended) {
     if (used == out.size()) {
+      if (stop_at_max && out.size() >= max_bytes) break;
       if (out.size() >= max_bytes) {
         throw Error(ErrorCode::out_of_range, std::string(location) +
                                                  ": decompressed data exceeds the limit of " +
@@ -130,6 +131,18 @@ std::vector<std::byte> inflate_all(std::span<const std::byte> in, std::uint64_t 
       throw Error(ErrorCode::truncated, std::string(location) + ": offset " +
                                             std::to_string(z.total_in()) +
                                             ": compressed stream ends early");
+    }
+  }
+  if (!ended) {
+    // Stopped at max_bytes: decode on into scratch so that a stream ending soon after is checked
+    // to its end (the gzip CRC catches damage the deflate codes did not). Surplus beyond 1 MiB
+    // is not examined.
+    std::vector<std::byte> scratch(1 << 16);
+    std::uint64_t surplus = 0;
+    while (!ended && surplus < (1u << 20)) {
+      const std::size_t n = z.run(in, scratch, ended);
+      if (n == 0 && !ended) break;
+      surplus += n;
     }
   }
   out.resize(used);

@@ -23,9 +23,6 @@ detail::SampleType sample_type(NiftiDatatype d) {
   return detail::SampleType::u8;
 }
 
-/// Largest decompressed .nii.gz accepted (a gzip bomb must not exhaust memory first).
-constexpr std::uint64_t kMaxDecompressed = std::uint64_t(1) << 40;
-
 VolumeDesc describe(const NiftiHeader& h) {
   VolumeDesc d;
   d.extent = h.extent();
@@ -61,9 +58,13 @@ std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayo
   if (detail::is_gzip(magic)) {
     std::vector<std::byte> packed(std::size_t(file.size()));
     file.read_at(0, packed);
-    const std::vector<std::byte> bytes = detail::inflate_all(packed, kMaxDecompressed, path);
+    // Header first, then exactly the bytes it announces: memory follows the decoded data and
+    // the header, not whatever a damaged stream would expand to.
+    const std::vector<std::byte> head = detail::inflate_all(packed, 348, path, true);
+    const NiftiHeader h = parse_nifti_header(head, path);
+    const std::uint64_t need = h.vox_offset + h.data_bytes();
+    const std::vector<std::byte> bytes = detail::inflate_all(packed, need, path, true);
     packed = {};
-    const NiftiHeader h = parse_nifti_header(bytes, path);
     return make_dense_pyramid_source(decode(h, bytes, path), layout, path, o);
   }
   std::array<std::byte, 348> head{};

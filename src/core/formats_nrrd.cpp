@@ -100,19 +100,22 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
     // As in teem, byte skip applies to the decompressed data of compressed encodings.
     std::vector<std::byte> packed(std::size_t(data.size() - std::min(data.size(), start)));
     data.read_at(start, packed);
-    // Deflate expands at most 1032:1, so a header announcing more than the packed bytes can
-    // hold is cut short. Checking before allocating keeps an 80-byte file from allocating the
-    // announced size (which threw std::bad_alloc), and the skip + size sum from wrapping.
+    // The buffer grows with the decoded data, so a header announcing more than the stream holds
+    // fails as truncated instead of allocating the announced size up front. Byte skip (< 2^63)
+    // plus the data size can wrap, which would make `want` small and the skip below point far
+    // outside the buffer.
     const std::uint64_t skip = std::uint64_t(h.byte_skip);
-    const std::uint64_t max_out = std::uint64_t(packed.size()) * 1032 + 64;
-    if (skip > max_out || need > max_out - skip) {
-      throw file_error(ErrorCode::truncated, data.path(), start,
-                       "gzip data of " + std::to_string(packed.size()) + " bytes cannot hold " +
-                           std::to_string(need) + " data bytes after skipping " +
-                           std::to_string(skip));
+    if (need > ~std::uint64_t(0) - skip) {
+      throw file_error(ErrorCode::overflow, data.path(), start,
+                       "byte skip plus data size overflows 64 bits");
     }
-    std::vector<std::byte> all(std::size_t(skip + need));
-    detail::inflate_exact(packed, all, detail::Deflate::any, data.path());
+    const std::uint64_t want = skip + need;
+    std::vector<std::byte> all = detail::inflate_all(packed, want, data.path(), true);
+    if (all.size() != want) {
+      throw file_error(ErrorCode::truncated, data.path(), start,
+                       "gzip data holds " + std::to_string(all.size()) + " bytes, the header " +
+                           "announces " + std::to_string(want));
+    }
     stored.assign(all.begin() + std::ptrdiff_t(h.byte_skip), all.end());
   } else {
     std::uint64_t offset = start + std::uint64_t(std::max<std::int64_t>(h.byte_skip, 0));

@@ -34,6 +34,8 @@ int ignore(TIFF*, void*, const char*, const char*, va_list) {
 class TiffFile {
  public:
   explicit TiffFile(const std::string& path) : path_(path) {
+    std::error_code ec;
+    bytes_ = std::filesystem::file_size(path, ec);
     TIFFOpenOptions* o = TIFFOpenOptionsAlloc();
     TIFFOpenOptionsSetErrorHandlerExtR(o, capture, &message_);
     TIFFOpenOptionsSetWarningHandlerExtR(o, ignore, nullptr);
@@ -51,10 +53,15 @@ class TiffFile {
   TIFF* get() const noexcept { return tif_; }
   const std::string& path() const noexcept { return path_; }
   std::string message() const { return message_.empty() ? "" : " (" + message_ + ")"; }
+  /// Most pixel bytes a page of this file can decode to: no TIFF codec expands beyond 4096:1
+  /// (LZW's longest string per 12-bit code), so larger claims are corrupt, and are rejected
+  /// before anything is allocated for them.
+  std::uint64_t max_page_bytes() const noexcept { return bytes_ * 4096 + (1u << 20); }
 
  private:
   std::string path_;
   std::string message_;
+  std::uint64_t bytes_ = 0;
   TIFF* tif_ = nullptr;
 };
 
@@ -91,13 +98,10 @@ PageFormat page_format(const TiffFile& f, std::uint64_t page) {
   return p;
 }
 
-/// No TIFF codec expands data by more than this (deflate ~1032:1, LZW ~2730:1, zstd ~32768:1);
-/// a file whose pages announce more pixels than its size allows is corrupt.
-constexpr std::uint64_t kMaxTiffRatio = std::uint64_t(1) << 15;
-
 /// Appends the current page's pixels (rows top to bottom, x fastest) to `out`. `budget` is what
-/// the rest of the file can still decode to (kMaxTiffRatio times its size); the page is charged
-/// against it before anything is allocated.
+/// the rest of the file can still decode to (TiffFile::max_page_bytes() for all its pages
+/// together, so many small IFDs cannot multiply it); the page is charged against it before
+/// anything is allocated.
 void read_page(const TiffFile& f, const PageFormat& p, std::uint64_t page,
                std::vector<std::byte>& out, std::uint64_t& budget) {
   TIFF* t = f.get();
@@ -177,9 +181,7 @@ std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const Bric
   std::uint64_t pages = 0;
   for (const std::string& file : stack_files(path)) {
     const TiffFile f(file);
-    std::uint64_t budget = std::filesystem::file_size(file, ec);
-    budget = ec || budget > ~std::uint64_t(0) / kMaxTiffRatio ? ~std::uint64_t(0)
-                                                              : budget * kMaxTiffRatio;
+    std::uint64_t budget = f.max_page_bytes();
     std::uint64_t page_in_file = 0;
     do {
       const PageFormat p = page_format(f, page_in_file);

@@ -223,7 +223,14 @@ TEST(Nrrd, MalformedHeadersAndFiles) {
   packed.resize(packed.size() - 10);
   gz.insert(gz.end(), packed.begin(), packed.end());
   test::write_bytes(dir.file("cut.nrrd"), gz);
-  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("cut.nrrd")), ErrorCode::size_mismatch, "cut.nrrd");
+  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("cut.nrrd")), ErrorCode::truncated, "cut.nrrd");
+  // A header announcing far more than the stream holds: truncated, without allocating it.
+  auto huge = text_bytes(
+      "NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 10000\nencoding: gzip\n\n");
+  const auto small = gzip(std::vector<std::uint8_t>(64, 1));
+  huge.insert(huge.end(), small.begin(), small.end());
+  test::write_bytes(dir.file("huge.nrrd"), huge);
+  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("huge.nrrd")), ErrorCode::truncated, "holds 64 bytes");
   test::write_bytes(dir.file("d.nhdr"),
                     text_bytes("NRRD0004\ntype: uchar\ndimension: 1\nsizes: 4\nencoding: "
                                "raw\ndata file: missing.raw\n"));

@@ -159,6 +159,21 @@ TEST(TiffStack, UnsupportedAndDamagedFiles) {
                       "damaged.tif: offset 0: page 0: row");
   test::write_bytes(dir.file("cut.tif"), bytes);
   EXPECT_RESOCT_ERROR(open_tiff_stack(dir.file("cut.tif")), ErrorCode::bad_magic, "cut.tif");
+  // A page claiming 60000x60000 pixels in a file of a few hundred bytes: rejected before any
+  // allocation (ImageWidth and ImageLength are the first two IFD entries, LONG values).
+  Page one;
+  one.values = values(one, 0);
+  TiffWriter g(false);
+  g.page(one);
+  auto giant = g.bytes();
+  const std::uint32_t ifd = std::uint32_t(test::get_le(giant, 4, 4));
+  test::put_le(giant, ifd + 2 + 8, 60000, 4);
+  test::put_le(giant, ifd + 2 + 12 + 8, 60000, 4);
+  test::write_bytes(dir.file("giant.tif"), giant);
+  EXPECT_TRUE(test::throws_error([&] { open_tiff_stack(dir.file("giant.tif")); },
+                                 ErrorCode::corrupt, "cannot be held by a file of this size") ||
+              test::throws_error([&] { open_tiff_stack(dir.file("giant.tif")); },
+                                 ErrorCode::bad_magic, "giant.tif"));
   TempDir empty;
   EXPECT_RESOCT_ERROR(open_tiff_stack(empty.path().string()), ErrorCode::invalid_argument,
                       "no .tif/.tiff files");

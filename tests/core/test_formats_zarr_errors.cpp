@@ -111,8 +111,9 @@ TEST(ZarrErrors, ChunkDecoding) {
                       ErrorCode::corrupt, "a/0.0.1: offset 0: not a valid blosc frame");
   // zlib / gzip: garbage and truncation.
   m.compressor = ZarrCompressor::zlib;
-  EXPECT_RESOCT_ERROR(decode_zarr_chunk(m, as_bytes({0x78, 0x9c, 0xff, 0xff, 0xff, 0xff}), "a/0.0.1"),
-                      ErrorCode::decompress_failed, "a/0.0.1");
+  EXPECT_RESOCT_ERROR(
+      decode_zarr_chunk(m, as_bytes({0x78, 0x9c, 0xff, 0xff, 0xff, 0xff}), "a/0.0.1"),
+      ErrorCode::decompress_failed, "a/0.0.1");
   m.compressor = ZarrCompressor::gzip;
   EXPECT_RESOCT_ERROR(decode_zarr_chunk(m, as_bytes({0x1f, 0x8b}), "a/0.0.1"),
                       ErrorCode::size_mismatch, "a/0.0.1");

@@ -36,7 +36,7 @@ TEST(FuzzRegressions, NrrdGzipAnnouncingMoreThanDeflateCanHoldIsTruncated) {
   // announced size before inflating (std::bad_alloc, or a gigabyte per file).
   for (const char* name : {"gzip-announces-1e15-bytes.nrrd", "gzip-announces-1e9-bytes.nrrd"}) {
     const std::string path = regression("nrrd_file", name);
-    EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, "cannot hold");
+    EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, "announces");
     EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::truncated, path);
   }
 }

@@ -53,7 +53,9 @@ TEST(OpenSource, NonexistentPathIsAnIoErrorListingTheForms) {
   const std::string missing = dir.file("missing.rbs");
   EXPECT_RESOCT_ERROR(open_source(missing), ErrorCode::io, missing);
   EXPECT_RESOCT_ERROR(open_source(missing), ErrorCode::io, "procedural:NAME");
-  EXPECT_RESOCT_ERROR(open_source(dir.path().string()), ErrorCode::io, "not a regular file");
+  // A directory is a source only when it is an OME-Zarr image or holds TIFF files.
+  EXPECT_RESOCT_ERROR(open_source(dir.path().string()), ErrorCode::invalid_argument,
+                      "neither an OME-Zarr image");
 }
 
 TEST(OpenSource, FileThatIsNotAStoreIsNamed) {
