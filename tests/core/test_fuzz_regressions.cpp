@@ -41,6 +41,13 @@ TEST(FuzzRegressions, NrrdGzipAnnouncingMoreThanDeflateCanHoldIsTruncated) {
   }
 }
 
+TEST(FuzzRegressions, NrrdByteSkipPlusSizeWrappingIsOverflow) {
+  // byte skip 2^62 + 5 plus 3 * 2^62 data bytes wraps to 5, which a 5-byte gzip stream then
+  // satisfied; skipping 2^62 + 5 bytes of it threw std::length_error.
+  const std::string path = regression("nrrd_file", "gzip-byte-skip-plus-size-wraps.nrrd");
+  EXPECT_RESOCT_ERROR(open_nrrd(path), ErrorCode::overflow, "byte skip plus data size");
+}
+
 TEST(FuzzRegressions, TiffPageAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
   // 638 bytes whose first page claims 65535x65535 pixels: open_tiff_stack allocated and cleared
   // 4.2 GB before libtiff failed to read the strips.
