@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -180,6 +181,53 @@ TEST(OmeZarr, OmeroWindowsAreChannelRanges) {
   EXPECT_EQ(src->multiscales().channels[0].label, "DAPI");
   EXPECT_EQ(src->multiscales().channels[1].color, "00FF00");
   EXPECT_EQ(src->array(0).compressor, ZarrCompressor::zlib);
+}
+
+/// Any ByteStore works (the HTTP store included); this one counts chunk reads.
+class CountingStore final : public ByteStore {
+ public:
+  explicit CountingStore(std::shared_ptr<ByteStore> inner) : inner_(std::move(inner)) {}
+  std::optional<std::vector<std::byte>> get(std::string_view key,
+                                            std::uint64_t max_bytes) const override {
+    if (!key.ends_with(".zarray") && !key.ends_with(".zattrs")) ++chunk_gets;
+    return inner_->get(key, max_bytes);
+  }
+  std::vector<std::byte> get_range(std::string_view key, std::uint64_t offset,
+                                   std::uint64_t size) const override {
+    return inner_->get_range(key, offset, size);
+  }
+  std::string location(std::string_view key) const override { return inner_->location(key); }
+  mutable std::atomic<std::uint64_t> chunk_gets{0};
+
+ private:
+  std::shared_ptr<ByteStore> inner_;
+};
+
+TEST(OmeZarr, DecodedChunkCacheServesEveryBrickCutFromAChunk) {
+  // A 3x4x3 grid of 4x3x5 (z, y, x) chunks; bricks of 4^3 with halo are cut across them.
+  const std::string dir = data_dir() + "/zstd_leu2_small_zyx.zarr";
+  const std::uint64_t chunks = 3 * 4 * 3;  // ceil(11/4) * ceil(10/3) * ceil(13/5)
+  for (std::uint64_t budget : {std::uint64_t(64) << 20, std::uint64_t(0)}) {
+    auto store = std::make_shared<CountingStore>(open_directory_store(dir));
+    OmeZarrOptions o;
+    o.chunk_cache_bytes = budget;
+    o.pyramid.threads = 1;
+    const auto src = open_ome_zarr(store, BrickLayout{glm::uvec3(4), 1}, o);
+    const std::uint64_t after_open = store->chunk_gets.load();
+    std::vector<std::byte> out(src->hierarchy().layout().padded_voxels() * 2);
+    for (std::uint64_t i = 0; i < src->hierarchy().level(0).brick_count; ++i) {
+      src->read_brick(src->hierarchy().key_from_linear(0, i), out);
+    }
+    if (budget != 0) {
+      // Each chunk is fetched and decoded once, by the open pass; bricks come from the cache.
+      EXPECT_EQ(after_open, chunks);
+      EXPECT_EQ(store->chunk_gets.load(), chunks);
+      EXPECT_GT(src->chunk_cache_stats().hits, 0u);
+    } else {
+      // Without a cache every brick refetches the chunks under it (halo neighbours included).
+      EXPECT_GT(store->chunk_gets.load() - after_open, chunks);
+    }
+  }
 }
 
 TEST(OmeZarr, RangesFromDataWithoutOmero) {

@@ -1,5 +1,7 @@
 #include "support/generated_data.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -13,6 +15,26 @@
 
 namespace resoct::test {
 
+namespace {
+
+/// An exclusive flock held for the lifetime of the object (released when the fd closes).
+class FileLock {
+ public:
+  explicit FileLock(const std::string& path) : fd_(::open(path.c_str(), O_CREAT | O_RDWR, 0644)) {
+    if (fd_ >= 0) ::flock(fd_, LOCK_EX);
+  }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+  ~FileLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+ private:
+  int fd_;
+};
+
+}  // namespace
+
 std::string python_generated_dir(const std::string& root, const std::string& name,
                                  const std::string& script) {
   namespace fs = std::filesystem;
@@ -22,29 +44,29 @@ std::string python_generated_dir(const std::string& root, const std::string& nam
     ADD_FAILURE() << "cannot read generator " << script;
     return {};
   }
-  // The stamp holds the script text: an edited script regenerates the data.
-  if (slurp((dir / ".generator").string()) == text) return dir.string();
   std::error_code ec;
   fs::create_directories(dir.parent_path(), ec);
-  const fs::path tmp = dir.string() + ".tmp." + std::to_string(::getpid());
+  // Test processes run in parallel; the first one generates while the others wait.
+  const FileLock lock(dir.string() + ".lock");
+  // The stamp holds the script text: an edited script regenerates the data.
+  if (slurp((dir / ".generator").string()) == text) return dir.string();
+  const fs::path tmp = dir.string() + ".tmp";
   fs::remove_all(tmp, ec);
+  const std::string log = tmp.string() + ".log";
   const std::string cmd = "/usr/bin/python3 " + shell_quote(script) + " " +
-                          shell_quote(tmp.string()) + " >" + shell_quote(tmp.string() + ".log") +
-                          " 2>&1";
+                          shell_quote(tmp.string()) + " >" + shell_quote(log) + " 2>&1";
   if (std::system(cmd.c_str()) != 0) {
-    ADD_FAILURE() << "generator failed: " << cmd << "\n" << slurp(tmp.string() + ".log");
+    ADD_FAILURE() << "generator failed: " << cmd << "\n" << slurp(log);
     return {};
   }
-  fs::remove(tmp.string() + ".log", ec);
+  fs::remove(log, ec);
   std::ofstream(tmp / ".generator", std::ios::binary) << text;
-  if (slurp((dir / ".generator").string()) != text) {
-    // Stale or absent: replace it. A concurrent process may win the rename; its data is equal.
-    const fs::path old = dir.string() + ".old." + std::to_string(::getpid());
-    fs::rename(dir, old, ec);
-    fs::rename(tmp, dir, ec);
-    fs::remove_all(old, ec);
+  fs::remove_all(dir, ec);
+  fs::rename(tmp, dir, ec);
+  if (ec) {
+    ADD_FAILURE() << "cannot move " << tmp << " to " << dir << ": " << ec.message();
+    return {};
   }
-  fs::remove_all(tmp, ec);
   return dir.string();
 }
 

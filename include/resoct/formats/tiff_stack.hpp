@@ -19,7 +19,10 @@ namespace resoct {
 /// when it cannot be read, Error(bad_magic) when libtiff does not recognise a file (its message
 /// included), Error(unsupported) naming the file and page for other sample layouts,
 /// Error(corrupt) naming the file and page when pages disagree in size or type or a strip or
-/// tile fails to decode, Error(invalid_argument) for a directory without TIFF files.
+/// tile fails to decode or a page claims more pixels than its file can hold,
+/// Error(invalid_argument) for a directory without TIFF files. Thread-safety: a pure function
+/// (libtiff messages are captured per file, not through global handlers); the source is
+/// thread-safe as BrickSource requires.
 std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path,
                                              const BrickLayout& layout = {});
 
