@@ -118,7 +118,7 @@ void read_page(const TiffFile& f, const PageFormat& p, std::uint64_t page,
   if (__builtin_mul_overflow(std::uint64_t(row), std::uint64_t(p.height), &bytes) ||
       bytes > budget) {
     throw fail(std::to_string(p.width) + "x" + std::to_string(p.height) +
-               " pixels cannot be stored in the rest of the file");
+               " pixels cannot be held by a file of this size");
   }
   budget -= bytes;
   out.resize(base + std::size_t(bytes));

@@ -53,7 +53,7 @@ TEST(FuzzRegressions, TiffPageAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
   // 4.2 GB before libtiff failed to read the strips.
   const std::string path = regression("tiff_file", "65535x65535-in-638-bytes.tif");
   EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt,
-                      "65535x65535 pixels cannot be stored");
+                      "65535x65535 pixels cannot be held");
   EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt, path);
 }
 
