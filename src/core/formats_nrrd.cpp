@@ -101,8 +101,15 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
     std::vector<std::byte> packed(std::size_t(data.size() - std::min(data.size(), start)));
     data.read_at(start, packed);
     // The buffer grows with the decoded data, so a header announcing more than the stream holds
-    // fails as truncated instead of allocating the announced size up front.
-    const std::uint64_t want = std::uint64_t(h.byte_skip) + need;
+    // fails as truncated instead of allocating the announced size up front. Byte skip (< 2^63)
+    // plus the data size can wrap, which would make `want` small and the skip below point far
+    // outside the buffer.
+    const std::uint64_t skip = std::uint64_t(h.byte_skip);
+    if (need > ~std::uint64_t(0) - skip) {
+      throw file_error(ErrorCode::overflow, data.path(), start,
+                       "byte skip plus data size overflows 64 bits");
+    }
+    const std::uint64_t want = skip + need;
     std::vector<std::byte> all = detail::inflate_all(packed, want, data.path(), true);
     if (all.size() != want) {
       throw file_error(ErrorCode::truncated, data.path(), start,

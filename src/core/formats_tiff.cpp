@@ -98,22 +98,30 @@ PageFormat page_format(const TiffFile& f, std::uint64_t page) {
   return p;
 }
 
-/// Appends the current page's pixels (rows top to bottom, x fastest) to `out`.
+/// Appends the current page's pixels (rows top to bottom, x fastest) to `out`. `budget` is what
+/// the rest of the file can still decode to (TiffFile::max_page_bytes() for all its pages
+/// together, so many small IFDs cannot multiply it); the page is charged against it before
+/// anything is allocated.
 void read_page(const TiffFile& f, const PageFormat& p, std::uint64_t page,
-               std::vector<std::byte>& out) {
+               std::vector<std::byte>& out, std::uint64_t& budget) {
   TIFF* t = f.get();
   const std::size_t vs = p.bits / 8u;
   const std::size_t row = std::size_t(p.width) * vs;
+  const std::size_t base = out.size();
   auto fail = [&](const std::string& what) {
     return file_error(ErrorCode::corrupt, f.path(), 0,
                       "page " + std::to_string(page) + ": " + what + f.message());
   };
-  if (std::uint64_t(row) * p.height > f.max_page_bytes()) {
+  // Checked before allocating: a 200-byte header announcing 65535x65535 pixels made this
+  // allocate 4 GB, and width * height * 4 bytes can wrap 64 bits.
+  std::uint64_t bytes = 0;
+  if (__builtin_mul_overflow(std::uint64_t(row), std::uint64_t(p.height), &bytes) ||
+      bytes > budget) {
     throw fail(std::to_string(p.width) + "x" + std::to_string(p.height) +
                " pixels cannot be held by a file of this size");
   }
-  const std::size_t base = out.size();
-  out.resize(base + row * p.height);
+  budget -= bytes;
+  out.resize(base + std::size_t(bytes));
   if (TIFFIsTiled(t) != 0) {
     std::uint32_t tw = 0, th = 0;
     TIFFGetField(t, TIFFTAG_TILEWIDTH, &tw);
@@ -173,6 +181,7 @@ std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const Bric
   std::uint64_t pages = 0;
   for (const std::string& file : stack_files(path)) {
     const TiffFile f(file);
+    std::uint64_t budget = f.max_page_bytes();
     std::uint64_t page_in_file = 0;
     do {
       const PageFormat p = page_format(f, page_in_file);
@@ -186,7 +195,7 @@ std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const Bric
                              std::to_string(first.height) + " " + std::to_string(first.bits) +
                              "-bit");
       }
-      read_page(f, p, page_in_file, voxels);
+      read_page(f, p, page_in_file, voxels, budget);
       ++pages;
       ++page_in_file;
     } while (TIFFReadDirectory(f.get()) == 1);

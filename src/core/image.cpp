@@ -89,9 +89,28 @@ Image read_png(const std::string& path) {
     std::fclose(f);
     return Error(ErrorCode::corrupt, msg);
   };
+  std::uint64_t file_bytes = 0;
+  if (std::fseek(f, 0, SEEK_END) == 0) {
+    const long end = std::ftell(f);
+    file_bytes = end > 0 ? std::uint64_t(end) : 0;
+  }
+  std::rewind(f);
   if (!png_image_begin_read_from_stdio(&png, f)) throw fail("not a readable PNG");
   if (png.width == 0 || png.height == 0 || png.width > 65536 || png.height > 65536) {
     throw fail("image size outside 1..65536");
+  }
+  // The pixels are deflated rows of at least one bit per pixel plus a filter byte, and deflate
+  // expands at most 1032:1. A header announcing more than the file can hold is corrupt; without
+  // this check an 83-byte file made us allocate and clear gigabytes before libpng noticed.
+  const std::uint64_t min_raw =
+      std::uint64_t(png.height) * (1 + (std::uint64_t(png.width) + 7) / 8);
+  if (min_raw / 1032 > file_bytes) {
+    const std::string msg = path + ": a " + std::to_string(png.width) + "x" +
+                            std::to_string(png.height) + " image cannot be stored in " +
+                            std::to_string(file_bytes) + " bytes";
+    png_image_free(&png);
+    std::fclose(f);
+    throw Error(ErrorCode::corrupt, msg);
   }
   png.format = PNG_FORMAT_RGBA;
   std::vector<std::uint8_t> rgba(PNG_IMAGE_SIZE(png));

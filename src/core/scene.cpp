@@ -292,6 +292,10 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
     doc = json::parse(json_text.begin(), json_text.end());
   } catch (const json::parse_error& e) {
     throw file_error(ErrorCode::corrupt, name, e.byte, std::string("malformed JSON: ") + e.what());
+  } catch (const json::exception& e) {
+    // Not only parse_error: a number literal beyond double's range ("1e3080") is out_of_range
+    // 406, which has no byte offset. Found by fuzz/fuzz_scene_json.cpp.
+    throw Error(ErrorCode::corrupt, name + ": malformed JSON: " + e.what());
   }
   const Reader r(name);
   if (!doc.is_object()) r.fail("(root)", "must be an object");
