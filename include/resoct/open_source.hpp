@@ -12,12 +12,15 @@ namespace resoct {
 
 /// The accepted forms, for help texts and error messages.
 inline constexpr std::string_view kSourceSpecForms =
-    "procedural:NAME[:WxHxD[:CHANNELS]] or the path of a resoct brick store (.rbs)";
+    "procedural:NAME[:WxHxD[:CHANNELS]], or the path or http(s):// URL of a resoct brick store "
+    "(.rbs)";
 
 /// Opens the source `spec` names:
 /// - `procedural:...` gives make_procedural_source(spec, layout);
 /// - a path to a brick store, recognized by its magic bytes (not its extension), gives a
-///   BrickStoreSource. `layout` is ignored: a store's brick layout is fixed when it is written.
+///   BrickStoreSource. `layout` is ignored: a store's brick layout is fixed when it is written;
+/// - an http:// or https:// URL of a brick store gives a BrickStoreSource reading by HTTP Range
+///   requests (open_random_access_file, default HttpOptions).
 /// Raw files need extent, type and byte order, so they are not accepted here: open them with
 /// open_raw_volume() and wrap the result in an InMemorySource (or convert them with
 /// resoct-convert).
