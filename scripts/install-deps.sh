@@ -11,6 +11,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libpng-dev libcli11-dev libcurl4-openssl-dev libblosc-dev libtiff-dev
   python3-matplotlib
+  # HTTP tests and bench_http: /usr/bin/python3 runs tests/support/http_test_server.py
+  python3
 )
 
 missing=()
