@@ -75,13 +75,20 @@ Camera orbit(const Camera& c, double deg) {
 void BM_PrefetchPath(benchmark::State& state) {
   const auto lookahead = std::uint32_t(state.range(0));
   const bool tiny = smoke();
-  const std::uint32_t path = tiny ? 4 : 40;
-  const double step_deg = 4.0;
-  const auto period = std::chrono::milliseconds(tiny ? 1 : 40);
-  const auto latency = std::chrono::microseconds(tiny ? 0 : 4000);
+  // The period exceeds the render time of a 32x32 frame even on a loaded machine, so that loading,
+  // not rendering, limits progress: one loader thread at 8 ms per brick
+  // (RESOCT_PREFETCH_LATENCY_US) reads about 30 bricks a frame, a little more than the orbit needs
+  // anew per frame, so prefetching has idle reads to use.
+  const std::uint32_t path = tiny ? 4 : 24;
+  const double step_deg = 5.0;
+  const auto period = std::chrono::milliseconds(tiny ? 1 : 250);
+  const char* env_latency = std::getenv("RESOCT_PREFETCH_LATENCY_US");
+  const auto latency = std::chrono::microseconds(tiny          ? 0
+                                                 : env_latency ? std::atol(env_latency)
+                                                               : 8000);
   cpu::register_backend();
   Scene scene = parse_scene(kTurbulenceScene, "turbulence");
-  scene.viewport = Viewport{tiny ? 24u : 64u, tiny ? 24u : 64u};
+  scene.viewport = Viewport{tiny ? 24u : 32u, tiny ? 24u : 32u};
   scene.camera.eye = scene.camera.target + 0.75 * (scene.camera.eye - scene.camera.target);
 
   double unconverged = 0, after_stop = 0, missing = 0, prefetched = 0, hits = 0, converged = 0;
@@ -94,7 +101,7 @@ void BM_PrefetchPath(benchmark::State& state) {
     RendererOptions o;
     o.backend = "cpu";
     o.backend_options.threads = 1;
-    o.loader_threads = 2;
+    o.loader_threads = 1;
     o.leaf_size = glm::uvec3(16);
     o.prefetch.lookahead_frames = lookahead;
     o.prefetch.max_bricks = 48;
