@@ -8,6 +8,9 @@ find_package(ZLIB REQUIRED)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
 find_package(nlohmann_json REQUIRED)
 find_package(PNG REQUIRED)
+# Volume file formats: blosc for OME-Zarr chunks, libtiff for TIFF stacks.
+pkg_check_modules(BLOSC REQUIRED IMPORTED_TARGET blosc)
+find_package(TIFF REQUIRED)
 
 find_package(Vulkan QUIET)
 find_program(RESOCT_GLSLANG_VALIDATOR NAMES glslangValidator)

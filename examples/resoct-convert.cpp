@@ -1,4 +1,5 @@
-// resoct-convert: writes a procedural volume or a raw binary file as a resoct brick store (.rbs).
+// resoct-convert: writes a procedural volume, a volume file (OME-Zarr, NIfTI, NRRD, TIFF, brick
+// store) or a raw binary file as a resoct brick store (.rbs).
 // See docs/tools.md.
 
 #include <sys/stat.h>
@@ -22,6 +23,7 @@
 #include "resoct/codec.hpp"
 #include "resoct/error.hpp"
 #include "resoct/in_memory_source.hpp"
+#include "resoct/open_source.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/raw_volume.hpp"
 #include "support/cli_parse.hpp"
@@ -48,10 +50,6 @@ struct Args {
   std::uint32_t metadata_block = 16;
   std::uint32_t threads = 0;
 };
-
-bool is_procedural(const std::string& s) {
-  return s.starts_with("procedural:");
-}
 
 // Fails before any work when the store could never be written, rather than after minutes of
 // conversion (the writer itself would also refuse, atomically).
@@ -204,9 +202,13 @@ int convert(const Args& a, const CLI::App& app) {
   check_output(a.output);
 
   std::unique_ptr<BrickSource> src;
-  if (is_procedural(a.input)) {
-    for (const char* raw_only :
-         {"--dims", "--type", "--endian", "--spacing", "--channels", "--offset", "--range"}) {
+  const char* const raw_options[] = {"--dims",     "--type",   "--endian", "--spacing",
+                                     "--channels", "--offset", "--range"};
+  bool raw_given = false;
+  for (const char* o : raw_options) raw_given = raw_given || app.count(o) != 0;
+  const SourceKind kind = detect_source_kind(a.input);
+  if (kind == SourceKind::procedural) {
+    for (const char* raw_only : raw_options) {
       if (app.count(raw_only) != 0) {
         throw invalid_parameter(raw_only,
                                 "applies to raw input only; a procedural spec carries "
@@ -214,8 +216,13 @@ int convert(const Args& a, const CLI::App& app) {
       }
     }
     src = make_procedural_source(a.input, layout);
-  } else {
+  } else if (kind == SourceKind::unknown || raw_given) {
+    // Raw options make any file raw (e.g. a header skipped with --offset).
     src = open_raw(a, app, layout);
+  } else {
+    std::fprintf(stderr, "%s: reading %s (coarser levels are built while writing)\n", kTool,
+                 a.input.c_str());
+    src = open_source(a.input, layout);
   }
 
   std::unique_ptr<Progress> progress;
@@ -242,12 +249,14 @@ int convert(const Args& a, const CLI::App& app) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Converts a procedural volume or a raw binary volume file into a resoct brick store "
-      "(.rbs). Raw input keeps its coarser levels in memory (about 1/7 of the input)."};
+      "Converts a procedural volume, a volume file (OME-Zarr directory, NIfTI .nii/.nii.gz, NRRD "
+      ".nrrd/.nhdr, TIFF file or directory, brick store, stack:A+B) or a raw binary volume file "
+      "into a resoct brick store (.rbs). Raw input keeps its coarser levels in memory (about 1/7 "
+      "of the input)."};
   one_line_usage_errors(app, kTool);
   Args a;
   app.add_option("input", a.input,
-                 "procedural:NAME[:WxHxD[:CHANNELS]] or a raw file (needs --dims and --type)")
+                 std::string(kSourceSpecForms) + ", or a raw file (needs --dims and --type)")
       ->required();
   app.add_option("output", a.output, "brick store to write (replaced atomically)")->required();
   auto* raw = "Raw input";

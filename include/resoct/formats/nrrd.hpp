@@ -1,0 +1,63 @@
+#pragma once
+/// \file
+/// NRRD volumes (.nrrd with attached data, .nhdr with a detached data file) as brick sources.
+/// Encodings raw and gzip; types uchar/uint8, ushort/uint16, short/int16 (served as f32 holding
+/// the same values, as for NIfTI), float; 1..4 dimensions: up to three spatial axes (x fastest),
+/// plus a channel axis that is either the first (interleaved, kind vector/list/RGB-color/...) or
+/// the last (one volume after another). Spacing from `spacings`, else the lengths of the
+/// `space directions` vectors, else 1. Each channel's value range is its data's finite min/max.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "resoct/brick_source.hpp"
+#include "resoct/raw_volume.hpp"
+
+namespace resoct {
+
+/// Stored NRRD sample types resoct reads.
+enum class NrrdType : std::uint8_t { u8, i16, u16, f32 };
+
+/// The fields of an NRRD header that resoct uses.
+struct NrrdHeader {
+  NrrdType type = NrrdType::u8;
+  std::vector<std::uint64_t> sizes;  ///< per axis, fastest first
+  bool gzip = false;                 ///< encoding gzip (else raw)
+  Endian endian = Endian::little;
+  /// -1: no channel axis; 0: the first axis holds channels (interleaved); otherwise the index
+  /// of the last axis, which holds channels.
+  int channel_axis = -1;
+  glm::dvec3 spacing{1.0};
+  std::string data_file;       ///< detached data file as written ("" = attached)
+  std::int64_t byte_skip = 0;  ///< bytes skipped before the data (after line_skip lines)
+  std::uint64_t line_skip = 0;
+  std::uint64_t header_bytes = 0;  ///< bytes up to and including the blank line ending the header
+
+  glm::u64vec3 extent() const noexcept;
+  std::uint32_t channels() const noexcept;
+  std::size_t stored_voxel_bytes() const noexcept;
+  /// Decoded bytes of all samples; Error(overflow) when it does not fit 64 bits.
+  std::uint64_t data_bytes() const;
+};
+
+/// Parses an NRRD header: `text` starts with the magic line and holds the header up to the
+/// blank line that ends it (anything after that is ignored; a detached header may end at the
+/// end of the text). Throws Error(bad_magic) naming `location` without "NRRD000x",
+/// Error(corrupt) naming the field and the line's byte offset for malformed lines, missing
+/// `type`/`dimension`/`sizes`/`encoding`, counts that disagree with `dimension`, zero sizes,
+/// bad spacings; Error(unsupported) naming the field for other types, encodings (ascii, hex,
+/// bzip2), data file lists, or an axis layout with no channel-axis interpretation.
+/// Thread-safety: a pure function.
+NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location);
+
+/// Opens a .nrrd / .nhdr file as a brick source whose coarser levels are built on demand. A
+/// detached data file is resolved relative to the header's directory. Voxels are held in memory.
+/// Throws what parse_nrrd_header throws, Error(io) / Error(truncated) naming the data file.
+std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayout& layout = {});
+
+}  // namespace resoct

@@ -1,0 +1,87 @@
+#pragma once
+/// \file
+/// Multiresolution on demand for inputs that store one resolution (NIfTI, NRRD, TIFF) or only
+/// some levels (an OME-Zarr multiscales image with fewer levels than resoct's hierarchy).
+///
+/// A level the input stores is read through its reader; any other level l is computed brick by
+/// brick from level l - 1 with downsample_region() (the project's one downsampling rule, along
+/// exactly the axes BrickHierarchy halves) and the computed brick cores are kept in an LRU cache
+/// with a byte budget, so a coarse level costs one pass over the finer one while it fits.
+/// Region metadata comes from a MetadataPyramid filled by one pass over level 0 at construction.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "resoct/brick_source.hpp"
+#include "resoct/dense_volume.hpp"
+#include "resoct/host_brick_cache.hpp"
+#include "resoct/metadata_pyramid.hpp"
+
+namespace resoct {
+
+/// Fills `out` (dense, x fastest) with the voxels of `box` of one channel of one level; the box
+/// lies inside the level. Must be callable from many threads at once.
+using LevelBoxReader =
+    std::function<void(std::uint32_t channel, const Box3& box, std::span<std::byte> out)>;
+
+struct PyramidSourceOptions {
+  /// Byte budget of computed coarse brick cores (LRU); 0 recomputes every time.
+  std::uint64_t cache_bytes = std::uint64_t(256) << 20;
+  /// Edge of a level-0 metadata block (power of two, 4..1024).
+  std::uint32_t metadata_block = 16;
+  /// Replace every channel's value range by the finite min/max of its level-0 data (an extra
+  /// pass; [lo, lo + 1] for a constant channel, [0, 1] for one without finite voxels).
+  bool ranges_from_data = false;
+  /// Threads of the level-0 passes; 0 = hardware concurrency.
+  std::uint32_t threads = 0;
+};
+
+/// Thread-safety: immutable after construction apart from the internal cache; every member may
+/// be called from any number of threads at once.
+class PyramidSource : public BrickSource {
+ public:
+  /// `levels[l]` reads hierarchy level l when the input stores it; empty entries and levels
+  /// beyond the vector are built on demand. levels[0] must be set. Runs the level-0 passes.
+  /// Throws Error(invalid_argument) for an invalid description, layout, options or a missing
+  /// level-0 reader, and whatever the readers throw.
+  PyramidSource(VolumeDesc desc, BrickLayout layout, std::vector<LevelBoxReader> levels,
+                std::string name, PyramidSourceOptions options = {});
+
+  const BrickHierarchy& hierarchy() const override { return hierarchy_; }
+  void read_brick(BrickKey key, std::span<std::byte> out) const override;
+  RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
+  std::string name() const override { return name_; }
+
+  /// The voxels of `box` (inside level `level`) of one channel, dense, x fastest.
+  /// Throws Error(invalid_argument) for a bad level, channel, box or buffer size.
+  void read_level_box(std::uint32_t level, std::uint32_t channel, const Box3& box,
+                      std::span<std::byte> out) const;
+  /// True when level `level` is read from the input rather than computed.
+  bool stored_level(std::uint32_t level) const noexcept;
+  const MetadataPyramid& metadata() const noexcept { return pyramid_; }
+  HostBrickCacheStats cache_stats() const { return cache_->stats(); }
+
+ private:
+  std::shared_ptr<const HostBrick> computed_core(std::uint32_t level, std::uint32_t channel,
+                                                 const glm::uvec3& brick) const;
+
+  BrickHierarchy hierarchy_;
+  std::vector<LevelBoxReader> levels_;
+  std::string name_;
+  MetadataPyramid pyramid_;
+  std::unique_ptr<HostBrickCache> cache_;
+};
+
+/// A PyramidSource over voxels held in memory (level 0 only; coarser levels on demand).
+std::unique_ptr<PyramidSource> make_dense_pyramid_source(DenseVolume volume, BrickLayout layout,
+                                                         std::string name,
+                                                         PyramidSourceOptions options = {});
+
+/// The value range rule of ranges_from_data over one channel's voxels (exposed for tests).
+ValueRange data_value_range(double finite_min, double finite_max) noexcept;
+
+}  // namespace resoct

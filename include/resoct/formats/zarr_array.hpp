@@ -1,0 +1,67 @@
+#pragma once
+/// \file
+/// Zarr v2 arrays: the `.zarray` metadata and the decoding of one stored chunk. Parsers are free
+/// functions over bytes so that fuzz targets and the HTTP reader call exactly what the zarr
+/// source calls. Supported: dtypes |u1, <u2, >u2, <f4, >f4; C order; no filters; compressors
+/// blosc (any inner codec libblosc was built with, byte or bit shuffle), lz4 (numcodecs framing:
+/// a 4-byte little-endian size, then one LZ4 block), zstd, zlib, gzip, none.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "resoct/raw_volume.hpp"
+#include "resoct/voxel_type.hpp"
+
+namespace resoct {
+
+/// How a chunk is compressed (numcodecs ids).
+enum class ZarrCompressor : std::uint8_t { none, blosc, lz4, zstd, zlib, gzip };
+
+/// "none", "blosc", "lz4", "zstd", "zlib", "gzip".
+std::string_view to_string(ZarrCompressor c) noexcept;
+
+/// Largest decoded chunk the reader accepts (a hostile `.zarray` must not make it allocate
+/// without bound): 1 GiB.
+inline constexpr std::uint64_t kMaxZarrChunkBytes = std::uint64_t(1) << 30;
+
+/// The parsed `.zarray` of one array. Dimensions are in the array's own axis order, slowest
+/// first (C order).
+struct ZarrArrayMeta {
+  std::vector<std::uint64_t> shape;   ///< voxels per dimension, each >= 1
+  std::vector<std::uint64_t> chunks;  ///< chunk shape, same rank, each >= 1
+  VoxelType type = VoxelType::u8;     ///< decoded voxel type
+  Endian endian = Endian::little;     ///< byte order of stored u2 / f4 voxels
+  ZarrCompressor compressor = ZarrCompressor::none;
+  double fill_value = 0.0;         ///< value of voxels in missing chunks (null: 0)
+  char dimension_separator = '.';  ///< '.' or '/' between chunk indices in chunk keys
+
+  /// Chunks per dimension: ceil(shape / chunks).
+  std::vector<std::uint64_t> chunk_grid() const;
+  /// Voxels in one (full) chunk.
+  std::uint64_t chunk_voxels() const;
+  /// Decoded bytes of one chunk: chunk_voxels() * voxel_size(type).
+  std::uint64_t chunk_bytes() const { return chunk_voxels() * voxel_size(type); }
+  /// The store key of a chunk relative to the array: "2.0.13" or "2/0/13".
+  std::string chunk_key(std::span<const std::uint64_t> chunk_index) const;
+};
+
+/// Parses `.zarray` JSON. `location` names the file in messages. Throws Error(corrupt) naming
+/// location and the key for malformed JSON, missing or mistyped keys, a rank mismatch between
+/// shape and chunks, zero sizes or a chunk above kMaxZarrChunkBytes; Error(unsupported_version)
+/// for zarr_format != 2; Error(unsupported) naming the key for F order, filters, an unknown
+/// compressor or an unsupported dtype. Thread-safety: a pure function.
+ZarrArrayMeta parse_zarr_array_meta(std::string_view json, std::string_view location);
+
+/// Decodes one stored chunk into its chunk_bytes() native-endian voxels (zarr stores border
+/// chunks at full size too). Throws Error(decompress_failed) naming `location` when the codec
+/// rejects the bytes, Error(size_mismatch) when they decode to another size than the chunk,
+/// Error(corrupt) for a damaged blosc or lz4 header. Thread-safety: a pure function.
+std::vector<std::byte> decode_zarr_chunk(const ZarrArrayMeta& meta,
+                                         std::span<const std::byte> encoded,
+                                         std::string_view location);
+
+}  // namespace resoct

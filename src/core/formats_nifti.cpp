@@ -1,0 +1,99 @@
+#include <array>
+#include <string>
+
+#include "formats_inflate.hpp"
+#include "formats_samples.hpp"
+#include "resoct/dense_volume.hpp"
+#include "resoct/error.hpp"
+#include "resoct/file_io.hpp"
+#include "resoct/formats/nifti.hpp"
+#include "resoct/formats/pyramid_source.hpp"
+
+namespace resoct {
+
+namespace {
+
+detail::SampleType sample_type(NiftiDatatype d) {
+  switch (d) {
+    case NiftiDatatype::u8: return detail::SampleType::u8;
+    case NiftiDatatype::i16: return detail::SampleType::i16;
+    case NiftiDatatype::u16: return detail::SampleType::u16;
+    case NiftiDatatype::f32: return detail::SampleType::f32;
+  }
+  return detail::SampleType::u8;
+}
+
+/// Largest decompressed .nii.gz accepted (a gzip bomb must not exhaust memory first).
+constexpr std::uint64_t kMaxDecompressed = std::uint64_t(1) << 40;
+
+VolumeDesc describe(const NiftiHeader& h) {
+  VolumeDesc d;
+  d.extent = h.extent();
+  d.spacing = h.spacing();
+  d.channels = h.volumes();
+  d.type = detail::voxel_type_for(sample_type(h.datatype), h.scaled());
+  return d;
+}
+
+DenseVolume decode(const NiftiHeader& h, std::span<const std::byte> file, const std::string& path) {
+  const std::uint64_t need = h.data_bytes();
+  if (file.size() < h.vox_offset || file.size() - h.vox_offset < need) {
+    throw file_error(ErrorCode::truncated, path, file.size(),
+                     "NIfTI data ends early: needs " + std::to_string(need) +
+                         " bytes from vox_offset " + std::to_string(h.vox_offset));
+  }
+  const VolumeDesc d = describe(h);
+  std::vector<std::byte> voxels(std::size_t(d.voxel_count() * d.channels * voxel_size(d.type)));
+  detail::convert_samples(file.subspan(std::size_t(h.vox_offset), std::size_t(need)),
+                          sample_type(h.datatype), h.endian, h.scaled(), h.scl_slope, h.scl_inter,
+                          voxels);
+  return DenseVolume::from_bytes(d, std::move(voxels));
+}
+
+}  // namespace
+
+std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayout& layout) {
+  const ReadFile file(path);
+  std::array<std::byte, 2> magic{};
+  if (file.size() >= 2) file.read_at(0, magic);
+  PyramidSourceOptions o;
+  o.ranges_from_data = true;
+  if (detail::is_gzip(magic)) {
+    std::vector<std::byte> packed(std::size_t(file.size()));
+    file.read_at(0, packed);
+    const std::vector<std::byte> bytes = detail::inflate_all(packed, kMaxDecompressed, path);
+    packed = {};
+    const NiftiHeader h = parse_nifti_header(bytes, path);
+    return make_dense_pyramid_source(decode(h, bytes, path), layout, path, o);
+  }
+  std::array<std::byte, 348> head{};
+  if (file.size() < head.size()) {
+    throw file_error(ErrorCode::truncated, path, file.size(),
+                     "NIfTI header needs 348 bytes, the file has " + std::to_string(file.size()));
+  }
+  file.read_at(0, head);
+  const NiftiHeader h = parse_nifti_header(head, path);
+  if (detail::samples_are_voxels(sample_type(h.datatype), h.endian, h.scaled())) {
+    // Stored voxels are resoct voxels: map the file instead of copying it.
+    const VolumeDesc d = describe(h);
+    RawVolumeOptions r;
+    r.extent = d.extent;
+    r.type = d.type;
+    r.endian = h.endian;
+    r.spacing = d.spacing;
+    r.channels = d.channels;
+    r.offset = h.vox_offset;
+    return make_dense_pyramid_source(open_raw_volume(path, r), layout, path, o);
+  }
+  const std::uint64_t need = h.data_bytes();
+  if (file.size() < h.vox_offset || file.size() - h.vox_offset < need) {
+    throw file_error(ErrorCode::truncated, path, file.size(),
+                     "NIfTI data ends early: needs " + std::to_string(need) +
+                         " bytes from vox_offset " + std::to_string(h.vox_offset));
+  }
+  std::vector<std::byte> bytes(std::size_t(h.vox_offset + need));
+  file.read_at(0, bytes);
+  return make_dense_pyramid_source(decode(h, bytes, path), layout, path, o);
+}
+
+}  // namespace resoct

@@ -1,0 +1,141 @@
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include "formats_inflate.hpp"
+#include "formats_samples.hpp"
+#include "resoct/dense_volume.hpp"
+#include "resoct/error.hpp"
+#include "resoct/file_io.hpp"
+#include "resoct/formats/nrrd.hpp"
+#include "resoct/formats/pyramid_source.hpp"
+
+namespace resoct {
+
+namespace {
+
+/// Longest header read (a header is text of a few hundred bytes; this bounds hostile files).
+constexpr std::uint64_t kMaxHeader = std::uint64_t(1) << 20;
+
+detail::SampleType sample_type(NrrdType t) {
+  switch (t) {
+    case NrrdType::u8: return detail::SampleType::u8;
+    case NrrdType::i16: return detail::SampleType::i16;
+    case NrrdType::u16: return detail::SampleType::u16;
+    case NrrdType::f32: return detail::SampleType::f32;
+  }
+  return detail::SampleType::u8;
+}
+
+/// Offset just past `lines` newlines starting at `from`.
+std::uint64_t skip_lines(const ReadFile& f, std::uint64_t from, std::uint64_t lines) {
+  std::uint64_t pos = from;
+  std::vector<std::byte> buf(1 << 16);
+  while (lines > 0) {
+    if (pos >= f.size()) {
+      throw file_error(ErrorCode::truncated, f.path(), pos, "file ends within 'line skip' lines");
+    }
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(buf.size(), f.size() - pos));
+    f.read_at(pos, std::span(buf).first(n));
+    std::size_t i = 0;
+    for (; i < n && lines > 0; ++i) {
+      if (buf[i] == std::byte('\n')) --lines;
+    }
+    pos += i;
+  }
+  return pos;
+}
+
+/// Channel-interleaved samples (channel fastest) to channel-major voxels.
+std::vector<std::byte> deinterleave(const std::vector<std::byte>& in, std::uint32_t channels,
+                                    std::size_t vs) {
+  std::vector<std::byte> out(in.size());
+  const std::size_t n = in.size() / vs / channels;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::uint32_t c = 0; c < channels; ++c) {
+      std::memcpy(out.data() + (c * n + i) * vs, in.data() + (i * channels + c) * vs, vs);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayout& layout) {
+  const ReadFile file(path);
+  std::string head(std::size_t(std::min(file.size(), kMaxHeader)), '\0');
+  file.read_at(0, std::as_writable_bytes(std::span(head)));
+  const NrrdHeader h = parse_nrrd_header(head, path);
+  const bool attached = h.data_file.empty();
+  if (attached && h.header_bytes >= head.size() && head.find("\n\n") == std::string::npos &&
+      head.find("\n\r\n") == std::string::npos) {
+    throw file_error(ErrorCode::truncated, path, head.size(),
+                     "no blank line ends the header, and no 'data file' is named");
+  }
+  std::string data_path = path;
+  if (!attached) {
+    const std::filesystem::path p(h.data_file);
+    data_path =
+        p.is_absolute() ? p.string() : (std::filesystem::path(path).parent_path() / p).string();
+  }
+  const ReadFile data_file_handle = attached ? ReadFile(path) : ReadFile(data_path);
+  const ReadFile& data = data_file_handle;
+  std::uint64_t start = attached ? h.header_bytes : 0;
+  start = skip_lines(data, start, h.line_skip);
+
+  VolumeDesc d;
+  d.extent = h.extent();
+  d.spacing = h.spacing;
+  d.channels = h.channels();
+  const auto st = sample_type(h.type);
+  d.type = detail::voxel_type_for(st, false);
+  const std::uint64_t need = h.data_bytes();
+  PyramidSourceOptions o;
+  o.ranges_from_data = true;
+  const std::string name = path;
+
+  std::vector<std::byte> stored;
+  if (h.gzip) {
+    // As in teem, byte skip applies to the decompressed data of compressed encodings.
+    std::vector<std::byte> packed(std::size_t(data.size() - std::min(data.size(), start)));
+    data.read_at(start, packed);
+    std::vector<std::byte> all(std::size_t(std::uint64_t(h.byte_skip) + need));
+    detail::inflate_exact(packed, all, detail::Deflate::any, data.path());
+    stored.assign(all.begin() + std::ptrdiff_t(h.byte_skip), all.end());
+  } else {
+    std::uint64_t offset = start + std::uint64_t(std::max<std::int64_t>(h.byte_skip, 0));
+    if (h.byte_skip == -1) {
+      if (data.size() < need) {
+        throw file_error(ErrorCode::truncated, data.path(), data.size(),
+                         "file is shorter than its " + std::to_string(need) + " data bytes");
+      }
+      offset = data.size() - need;
+    }
+    if (h.channel_axis != 0 && detail::samples_are_voxels(st, h.endian, false)) {
+      RawVolumeOptions r;
+      r.extent = d.extent;
+      r.type = d.type;
+      r.endian = h.endian;
+      r.spacing = d.spacing;
+      r.channels = d.channels;
+      r.offset = offset;
+      return make_dense_pyramid_source(open_raw_volume(data.path(), r), layout, name, o);
+    }
+    if (offset > data.size() || data.size() - offset < need) {
+      throw file_error(ErrorCode::truncated, data.path(), data.size(),
+                       "data ends early: needs " + std::to_string(need) + " bytes from offset " +
+                           std::to_string(offset));
+    }
+    stored.resize(std::size_t(need));
+    data.read_at(offset, stored);
+  }
+  std::vector<std::byte> voxels(std::size_t(need / detail::sample_bytes(st) * voxel_size(d.type)));
+  detail::convert_samples(stored, st, h.endian, false, 1.0, 0.0, voxels);
+  if (h.channel_axis == 0 && d.channels > 1) {
+    voxels = deinterleave(voxels, d.channels, voxel_size(d.type));
+  }
+  return make_dense_pyramid_source(DenseVolume::from_bytes(d, std::move(voxels)), layout, name, o);
+}
+
+}  // namespace resoct

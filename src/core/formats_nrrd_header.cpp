@@ -1,0 +1,321 @@
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "resoct/error.hpp"
+#include "resoct/formats/nrrd.hpp"
+
+namespace resoct {
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
+  return s;
+}
+
+/// Splits on blanks, keeping "(...)" groups of space vectors together.
+std::vector<std::string_view> tokens(std::string_view s) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
+    if (i >= s.size()) break;
+    const std::size_t start = i;
+    int depth = 0;
+    while (i < s.size() && (depth > 0 || (s[i] != ' ' && s[i] != '\t'))) {
+      if (s[i] == '(') ++depth;
+      if (s[i] == ')') --depth;
+      ++i;
+    }
+    out.push_back(s.substr(start, i - start));
+  }
+  return out;
+}
+
+struct Line {
+  std::string_view field;
+  std::string_view value;
+  std::uint64_t offset;
+};
+
+class Parser {
+ public:
+  explicit Parser(std::string_view location) : location_(location) {}
+
+  [[noreturn]] void fail(ErrorCode code, const Line& l, const std::string& why) const {
+    throw file_error(code, location_, l.offset,
+                     "NRRD field '" + std::string(l.field) + "': " + why);
+  }
+
+  std::optional<double> number(std::string_view t) const {
+    const std::string s(t);
+    if (s == "nan" || s == "NaN" || s == "NAN") return std::nullopt;
+    char* end = nullptr;
+    const double d = std::strtod(s.c_str(), &end);
+    if (s.empty() || end != s.c_str() + s.size() || !std::isfinite(d)) return std::nullopt;
+    return d;
+  }
+
+  std::int64_t integer(const Line& l, std::string_view t) const {
+    std::int64_t v = 0;
+    const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (r.ec != std::errc() || r.ptr != t.data() + t.size()) {
+      fail(ErrorCode::corrupt, l, "expected an integer, got '" + std::string(t) + "'");
+    }
+    return v;
+  }
+
+ private:
+  std::string_view location_;
+};
+
+NrrdType parse_type(const Parser& p, const Line& l) {
+  const std::string v(l.value);
+  if (v == "uchar" || v == "unsigned char" || v == "uint8" || v == "uint8_t") return NrrdType::u8;
+  if (v == "short" || v == "short int" || v == "signed short" || v == "signed short int" ||
+      v == "int16" || v == "int16_t") {
+    return NrrdType::i16;
+  }
+  if (v == "ushort" || v == "unsigned short" || v == "unsigned short int" || v == "uint16" ||
+      v == "uint16_t") {
+    return NrrdType::u16;
+  }
+  if (v == "float") return NrrdType::f32;
+  p.fail(ErrorCode::unsupported, l,
+         "type '" + v + "' is not supported (uint8, int16, uint16, float are)");
+}
+
+bool domain_kind(std::string_view k) {
+  return k == "domain" || k == "space" || k == "time" || k == "???" || k == "none";
+}
+
+}  // namespace
+
+glm::u64vec3 NrrdHeader::extent() const noexcept {
+  glm::u64vec3 e(1);
+  int a = 0;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    if (int(i) == channel_axis) continue;
+    if (a < 3) e[a++] = sizes[i];
+  }
+  return e;
+}
+
+std::uint32_t NrrdHeader::channels() const noexcept {
+  return channel_axis < 0 ? 1u : std::uint32_t(sizes[std::size_t(channel_axis)]);
+}
+
+std::size_t NrrdHeader::stored_voxel_bytes() const noexcept {
+  return type == NrrdType::u8 ? 1u : type == NrrdType::f32 ? 4u : 2u;
+}
+
+std::uint64_t NrrdHeader::data_bytes() const {
+  std::uint64_t n = stored_voxel_bytes();
+  for (std::uint64_t s : sizes) {
+    if (n > ~std::uint64_t(0) / s) throw Error(ErrorCode::overflow, "NRRD data size overflows");
+    n *= s;
+  }
+  return n;
+}
+
+NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
+  if (!text.starts_with("NRRD000") || text.size() < 8 || text[7] < '1' || text[7] > '5') {
+    throw file_error(ErrorCode::bad_magic, location, 0, "not an NRRD file (no NRRD000x magic)");
+  }
+  const Parser p(location);
+  std::vector<Line> lines;
+  std::size_t pos = text.find('\n');
+  NrrdHeader h;
+  h.header_bytes = text.size();
+  while (pos != std::string_view::npos && pos + 1 <= text.size()) {
+    const std::size_t start = pos + 1;
+    std::size_t end = text.find('\n', start);
+    const bool last = end == std::string_view::npos;
+    if (last) end = text.size();
+    const std::string_view raw = text.substr(start, end - start);
+    const std::string_view line = trim(raw);
+    if (raw.empty() || raw == "\r") {
+      if (!last) h.header_bytes = end + 1;
+      break;
+    }
+    pos = last ? std::string_view::npos : end;
+    if (line.empty() || line.front() == '#') continue;
+    const std::size_t kv = line.find(":=");
+    const std::size_t colon = line.find(": ");
+    if (kv != std::string_view::npos && (colon == std::string_view::npos || kv < colon)) continue;
+    if (colon == std::string_view::npos) {
+      throw file_error(ErrorCode::corrupt, location, start,
+                       "NRRD header line without 'field: value': '" + std::string(line) + "'");
+    }
+    lines.push_back({line.substr(0, colon), trim(line.substr(colon + 2)), start});
+  }
+
+  const Line* type = nullptr;
+  const Line* dimension = nullptr;
+  const Line* sizes = nullptr;
+  const Line* encoding = nullptr;
+  const Line* spacings = nullptr;
+  const Line* directions = nullptr;
+  const Line* kinds = nullptr;
+  for (const Line& l : lines) {
+    const std::string_view f = l.field;
+    if (f == "type") {
+      type = &l;
+    } else if (f == "dimension") {
+      dimension = &l;
+    } else if (f == "sizes") {
+      sizes = &l;
+    } else if (f == "encoding") {
+      encoding = &l;
+    } else if (f == "spacings") {
+      spacings = &l;
+    } else if (f == "space directions") {
+      directions = &l;
+    } else if (f == "kinds") {
+      kinds = &l;
+    } else if (f == "endian") {
+      if (l.value == "little") {
+        h.endian = Endian::little;
+      } else if (l.value == "big") {
+        h.endian = Endian::big;
+      } else {
+        p.fail(ErrorCode::corrupt, l, "expected little or big, got '" + std::string(l.value) + "'");
+      }
+    } else if (f == "data file" || f == "datafile") {
+      if (l.value.starts_with("LIST") || l.value.find('%') != std::string_view::npos ||
+          tokens(l.value).size() != 1) {
+        p.fail(ErrorCode::unsupported, l, "only a single detached data file is supported");
+      }
+      h.data_file = std::string(l.value);
+    } else if (f == "byte skip" || f == "byteskip") {
+      h.byte_skip = p.integer(l, l.value);
+      if (h.byte_skip < -1) p.fail(ErrorCode::corrupt, l, "must be >= -1");
+    } else if (f == "line skip" || f == "lineskip") {
+      const std::int64_t v = p.integer(l, l.value);
+      if (v < 0) p.fail(ErrorCode::corrupt, l, "must be >= 0");
+      h.line_skip = std::uint64_t(v);
+    }
+  }
+  for (auto [ptr, name] : {std::pair{type, "type"}, std::pair{dimension, "dimension"},
+                           std::pair{sizes, "sizes"}, std::pair{encoding, "encoding"}}) {
+    if (ptr == nullptr) {
+      throw file_error(ErrorCode::corrupt, location, 0,
+                       "NRRD field '" + std::string(name) + "' is missing");
+    }
+  }
+  h.type = parse_type(p, *type);
+  const std::int64_t d = p.integer(*dimension, dimension->value);
+  if (d < 1 || d > 16) p.fail(ErrorCode::corrupt, *dimension, "must be 1..16");
+  if (d > 4) p.fail(ErrorCode::unsupported, *dimension, "at most 4 axes are supported");
+  const auto dim = std::size_t(d);
+  const auto size_tokens = tokens(sizes->value);
+  if (size_tokens.size() != dim) {
+    p.fail(ErrorCode::corrupt, *sizes, "expected " + std::to_string(dim) + " sizes");
+  }
+  for (std::string_view t : size_tokens) {
+    const std::int64_t s = p.integer(*sizes, t);
+    if (s < 1) p.fail(ErrorCode::corrupt, *sizes, "sizes must be >= 1");
+    h.sizes.push_back(std::uint64_t(s));
+  }
+  if (encoding->value == "raw") {
+    h.gzip = false;
+  } else if (encoding->value == "gzip" || encoding->value == "gz") {
+    h.gzip = true;
+  } else {
+    p.fail(ErrorCode::unsupported, *encoding,
+           "encoding '" + std::string(encoding->value) + "' is not supported (raw, gzip are)");
+  }
+  if (h.byte_skip == -1 && h.gzip) {
+    throw file_error(ErrorCode::corrupt, location, 0,
+                     "NRRD field 'byte skip': -1 is only defined for raw encoding");
+  }
+
+  // Which axes are not spatial: kinds first, else "none" space directions.
+  std::vector<bool> non_spatial(dim, false);
+  if (kinds != nullptr) {
+    const auto k = tokens(kinds->value);
+    if (k.size() != dim) p.fail(ErrorCode::corrupt, *kinds, "expected " + std::to_string(dim));
+    for (std::size_t i = 0; i < dim; ++i) non_spatial[i] = !domain_kind(k[i]);
+  }
+  std::vector<std::optional<double>> lengths(dim);
+  if (directions != nullptr) {
+    const auto v = tokens(directions->value);
+    if (v.size() != dim) {
+      p.fail(ErrorCode::corrupt, *directions, "expected " + std::to_string(dim) + " entries");
+    }
+    for (std::size_t i = 0; i < dim; ++i) {
+      if (v[i] == "none") {
+        non_spatial[i] = true;
+        continue;
+      }
+      if (v[i].size() < 2 || v[i].front() != '(' || v[i].back() != ')') {
+        p.fail(ErrorCode::corrupt, *directions, "expected (x,y,z) or none");
+      }
+      std::string_view inner = v[i].substr(1, v[i].size() - 2);
+      double sum = 0.0;
+      std::size_t n = 0;
+      while (true) {
+        const std::size_t comma = inner.find(',');
+        const auto c = p.number(trim(inner.substr(0, comma)));
+        if (!c) p.fail(ErrorCode::corrupt, *directions, "vector components must be numbers");
+        sum += *c * *c;
+        ++n;
+        if (comma == std::string_view::npos) break;
+        inner = inner.substr(comma + 1);
+      }
+      if (n < 1 || n > 3) p.fail(ErrorCode::corrupt, *directions, "vectors have 1..3 components");
+      lengths[i] = std::sqrt(sum);
+    }
+  }
+  if (dim == 4) {
+    if (non_spatial[0]) {
+      h.channel_axis = 0;
+    } else {
+      h.channel_axis = 3;
+    }
+    if (h.sizes[std::size_t(h.channel_axis)] > 256) {
+      p.fail(ErrorCode::unsupported, *sizes, "a channel axis holds at most 256 channels");
+    }
+  } else {
+    for (std::size_t i = 0; i < dim; ++i) {
+      if (non_spatial[i] && h.sizes[i] != 1 && dim > 1) {
+        p.fail(ErrorCode::unsupported, kinds != nullptr ? *kinds : *directions,
+               "a non-spatial axis is only supported as the first or last of 4 axes");
+      }
+    }
+  }
+  std::vector<std::optional<double>> spacing(dim);
+  if (spacings != nullptr) {
+    const auto v = tokens(spacings->value);
+    if (v.size() != dim) {
+      p.fail(ErrorCode::corrupt, *spacings, "expected " + std::to_string(dim) + " spacings");
+    }
+    for (std::size_t i = 0; i < dim; ++i) {
+      spacing[i] = p.number(v[i]);
+      if (spacing[i] && *spacing[i] <= 0.0) spacing[i] = std::fabs(*spacing[i]);
+    }
+  }
+  int a = 0;
+  for (std::size_t i = 0; i < dim && a < 3; ++i) {
+    if (int(i) == h.channel_axis) continue;
+    double s = 1.0;
+    if (spacing[i] && *spacing[i] > 0.0) {
+      s = *spacing[i];
+    } else if (lengths[i] && *lengths[i] > 0.0 && std::isfinite(*lengths[i])) {
+      s = *lengths[i];
+    }
+    h.spacing[a++] = s;
+  }
+  try {
+    (void)h.data_bytes();
+  } catch (const Error&) {
+    p.fail(ErrorCode::overflow, *sizes, "data size overflows 64 bits");
+  }
+  return h;
+}
+
+}  // namespace resoct

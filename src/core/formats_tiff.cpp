@@ -1,0 +1,191 @@
+#include <algorithm>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <tiffio.h>
+
+#include "resoct/dense_volume.hpp"
+#include "resoct/error.hpp"
+#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/formats/tiff_stack.hpp"
+
+namespace resoct {
+
+namespace {
+
+/// libtiff reports through handlers; this one keeps the last message per open file so that it
+/// ends up in the Error instead of on stderr.
+int capture(TIFF*, void* user, const char* module, const char* fmt, va_list ap) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, fmt, ap);
+  auto* out = static_cast<std::string*>(user);
+  *out = std::string(module != nullptr ? module : "libtiff") + ": " + text;
+  return 1;
+}
+
+int ignore(TIFF*, void*, const char*, const char*, va_list) {
+  return 1;
+}
+
+class TiffFile {
+ public:
+  explicit TiffFile(const std::string& path) : path_(path) {
+    TIFFOpenOptions* o = TIFFOpenOptionsAlloc();
+    TIFFOpenOptionsSetErrorHandlerExtR(o, capture, &message_);
+    TIFFOpenOptionsSetWarningHandlerExtR(o, ignore, nullptr);
+    tif_ = TIFFOpenExt(path.c_str(), "r", o);
+    TIFFOpenOptionsFree(o);
+    if (tif_ == nullptr) {
+      throw file_error(
+          ErrorCode::bad_magic, path, 0,
+          "not a readable TIFF file" + (message_.empty() ? "" : " (" + message_ + ")"));
+    }
+  }
+  TiffFile(const TiffFile&) = delete;
+  TiffFile& operator=(const TiffFile&) = delete;
+  ~TiffFile() { TIFFClose(tif_); }
+  TIFF* get() const noexcept { return tif_; }
+  const std::string& path() const noexcept { return path_; }
+  std::string message() const { return message_.empty() ? "" : " (" + message_ + ")"; }
+
+ private:
+  std::string path_;
+  std::string message_;
+  TIFF* tif_ = nullptr;
+};
+
+struct PageFormat {
+  std::uint32_t width = 0, height = 0;
+  std::uint16_t bits = 0, format = SAMPLEFORMAT_UINT;
+  friend bool operator==(const PageFormat&, const PageFormat&) = default;
+};
+
+PageFormat page_format(const TiffFile& f, std::uint64_t page) {
+  TIFF* t = f.get();
+  PageFormat p;
+  std::uint16_t spp = 1;
+  TIFFGetField(t, TIFFTAG_IMAGEWIDTH, &p.width);
+  TIFFGetField(t, TIFFTAG_IMAGELENGTH, &p.height);
+  TIFFGetFieldDefaulted(t, TIFFTAG_BITSPERSAMPLE, &p.bits);
+  TIFFGetFieldDefaulted(t, TIFFTAG_SAMPLESPERPIXEL, &spp);
+  TIFFGetFieldDefaulted(t, TIFFTAG_SAMPLEFORMAT, &p.format);
+  const std::string where = "page " + std::to_string(page) + ": ";
+  if (p.width == 0 || p.height == 0) {
+    throw file_error(ErrorCode::corrupt, f.path(), 0, where + "zero width or height");
+  }
+  if (spp != 1) {
+    throw file_error(ErrorCode::unsupported, f.path(), 0,
+                     where + std::to_string(spp) + " samples per pixel (grayscale only)");
+  }
+  const bool ok = (p.format == SAMPLEFORMAT_UINT && (p.bits == 8 || p.bits == 16)) ||
+                  (p.format == SAMPLEFORMAT_IEEEFP && p.bits == 32);
+  if (!ok) {
+    throw file_error(ErrorCode::unsupported, f.path(), 0,
+                     where + std::to_string(p.bits) + "-bit samples of format " +
+                         std::to_string(p.format) + " (8/16-bit unsigned or 32-bit float only)");
+  }
+  return p;
+}
+
+/// Appends the current page's pixels (rows top to bottom, x fastest) to `out`.
+void read_page(const TiffFile& f, const PageFormat& p, std::uint64_t page,
+               std::vector<std::byte>& out) {
+  TIFF* t = f.get();
+  const std::size_t vs = p.bits / 8u;
+  const std::size_t row = std::size_t(p.width) * vs;
+  const std::size_t base = out.size();
+  out.resize(base + row * p.height);
+  auto fail = [&](const std::string& what) {
+    return file_error(ErrorCode::corrupt, f.path(), 0,
+                      "page " + std::to_string(page) + ": " + what + f.message());
+  };
+  if (TIFFIsTiled(t) != 0) {
+    std::uint32_t tw = 0, th = 0;
+    TIFFGetField(t, TIFFTAG_TILEWIDTH, &tw);
+    TIFFGetField(t, TIFFTAG_TILELENGTH, &th);
+    if (tw == 0 || th == 0) throw fail("zero tile size");
+    std::vector<std::byte> tile(std::size_t(TIFFTileSize(t)));
+    if (tile.size() < std::size_t(tw) * th * vs) throw fail("tile buffer smaller than a tile");
+    for (std::uint32_t y0 = 0; y0 < p.height; y0 += th) {
+      for (std::uint32_t x0 = 0; x0 < p.width; x0 += tw) {
+        if (TIFFReadTile(t, tile.data(), x0, y0, 0, 0) < 0) {
+          throw fail("tile at " + std::to_string(x0) + "," + std::to_string(y0) + " unreadable");
+        }
+        const std::uint32_t w = std::min(tw, p.width - x0), h = std::min(th, p.height - y0);
+        for (std::uint32_t y = 0; y < h; ++y) {
+          std::memcpy(out.data() + base + (y0 + y) * row + x0 * vs, tile.data() + y * tw * vs,
+                      w * vs);
+        }
+      }
+    }
+    return;
+  }
+  if (std::size_t(TIFFScanlineSize(t)) != row) throw fail("unexpected scanline size");
+  for (std::uint32_t y = 0; y < p.height; ++y) {
+    if (TIFFReadScanline(t, out.data() + base + y * row, y, 0) < 0) {
+      throw fail("row " + std::to_string(y) + " unreadable");
+    }
+  }
+}
+
+std::vector<std::string> stack_files(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(path, ec)) return {path};
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(path, ec)) {
+    std::string ext = e.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](char c) { return char(std::tolower(c)); });
+    if (e.is_regular_file() && (ext == ".tif" || ext == ".tiff"))
+      files.push_back(e.path().string());
+  }
+  if (ec) throw file_error(ErrorCode::io, path, 0, "cannot list directory: " + ec.message());
+  if (files.empty()) throw invalid_parameter("path", "'" + path + "' holds no .tif/.tiff files");
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace
+
+std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const BrickLayout& layout) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    throw file_error(ErrorCode::io, path, 0, "does not exist");
+  }
+  std::vector<std::byte> voxels;
+  PageFormat first;
+  std::uint64_t pages = 0;
+  for (const std::string& file : stack_files(path)) {
+    const TiffFile f(file);
+    std::uint64_t page_in_file = 0;
+    do {
+      const PageFormat p = page_format(f, page_in_file);
+      if (pages == 0) {
+        first = p;
+      } else if (!(p == first)) {
+        throw file_error(ErrorCode::corrupt, file, 0,
+                         "page " + std::to_string(page_in_file) + " is " + std::to_string(p.width) +
+                             "x" + std::to_string(p.height) + " " + std::to_string(p.bits) +
+                             "-bit, the first page " + std::to_string(first.width) + "x" +
+                             std::to_string(first.height) + " " + std::to_string(first.bits) +
+                             "-bit");
+      }
+      read_page(f, p, page_in_file, voxels);
+      ++pages;
+      ++page_in_file;
+    } while (TIFFReadDirectory(f.get()) == 1);
+  }
+  VolumeDesc d;
+  d.extent = {first.width, first.height, pages};
+  d.type = first.bits == 8 ? VoxelType::u8 : first.bits == 16 ? VoxelType::u16 : VoxelType::f32;
+  PyramidSourceOptions o;
+  o.ranges_from_data = true;
+  return make_dense_pyramid_source(DenseVolume::from_bytes(d, std::move(voxels)), layout, path, o);
+}
+
+}  // namespace resoct

@@ -1,0 +1,233 @@
+// NRRD: files written by the test from the NRRD format description (attached and detached data,
+// raw and gzip encodings, both byte orders, every sample type, channel axes first or last,
+// spacings / space directions, byte and line skips), and malformed headers and files.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <zlib.h>
+
+#include "core/test_brick_store_util.hpp"
+#include "resoct/error.hpp"
+#include "resoct/formats/nrrd.hpp"
+#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/open_source.hpp"
+#include "support/expect_error.hpp"
+
+using namespace resoct;
+using test::TempDir;
+
+namespace {
+
+std::vector<std::uint8_t> text_bytes(const std::string& s) {
+  return std::vector<std::uint8_t>(s.begin(), s.end());
+}
+
+std::vector<std::uint8_t> gzip(const std::vector<std::uint8_t>& in) {
+  z_stream z{};
+  deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
+  std::vector<std::uint8_t> out(deflateBound(&z, uLong(in.size())) + 64);
+  z.next_in = const_cast<Bytef*>(in.data());
+  z.avail_in = uInt(in.size());
+  z.next_out = out.data();
+  z.avail_out = uInt(out.size());
+  deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return out;
+}
+
+/// Sample i of the test volume in the stored type, appended in the given byte order.
+void append_sample(std::vector<std::uint8_t>& b, const std::string& type, double v, bool big) {
+  std::uint8_t tmp[4];
+  std::size_t n = 0;
+  if (type == "uchar") {
+    tmp[0] = std::uint8_t(v), n = 1;
+  } else if (type == "short") {
+    const auto s = std::int16_t(v);
+    std::memcpy(tmp, &s, 2), n = 2;
+  } else if (type == "ushort") {
+    const auto s = std::uint16_t(v);
+    std::memcpy(tmp, &s, 2), n = 2;
+  } else {
+    const auto f = float(v);
+    std::memcpy(tmp, &f, 4), n = 4;
+  }
+  for (std::size_t i = 0; i < n; ++i) b.push_back(big ? tmp[n - 1 - i] : tmp[i]);
+}
+
+double sample_value(const std::string& type, std::size_t i) {
+  if (type == "uchar") return double((i * 13) % 256);
+  if (type == "short") return double(std::int64_t(i * 211 % 4000) - 2000);
+  if (type == "ushort") return double((i * 977) % 65536);
+  return double(i) * 0.125 - 3.0;
+}
+
+std::vector<double> level0(const BrickSource& s, std::uint32_t channel) {
+  const auto& p = dynamic_cast<const PyramidSource&>(s);
+  const VolumeDesc& d = s.volume();
+  std::vector<std::byte> bytes(d.voxel_count() * voxel_size(d.type));
+  p.read_level_box(0, channel, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, bytes);
+  std::vector<double> v;
+  for (std::size_t i = 0; i < d.voxel_count(); ++i) {
+    if (d.type == VoxelType::u8) v.push_back(double(std::uint8_t(bytes[i])));
+    if (d.type == VoxelType::u16) {
+      std::uint16_t x;
+      std::memcpy(&x, bytes.data() + 2 * i, 2);
+      v.push_back(x);
+    }
+    if (d.type == VoxelType::f32) {
+      float x;
+      std::memcpy(&x, bytes.data() + 4 * i, 4);
+      v.push_back(x);
+    }
+  }
+  return v;
+}
+
+TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
+  TempDir dir;
+  const glm::u64vec3 e(6, 5, 4);
+  const std::size_t n = 120;
+  for (const std::string type : {"uchar", "short", "ushort", "float"}) {
+    for (bool gz : {false, true}) {
+      for (bool big : {false, true}) {
+        for (bool detached : {false, true}) {
+          SCOPED_TRACE(type + (gz ? " gzip" : " raw") + (big ? " big" : " little") +
+                       (detached ? " detached" : " attached"));
+          std::vector<std::uint8_t> data;
+          for (std::size_t i = 0; i < n; ++i) append_sample(data, type, sample_value(type, i), big);
+          if (gz) data = gzip(data);
+          std::string head = "NRRD0004\n# a comment\ntype: " + type +
+                             "\ndimension: 3\nsizes: 6 5 4\nencoding: " + (gz ? "gzip" : "raw") +
+                             "\nendian: " + (big ? "big" : "little") +
+                             "\nspacings: 0.5 0.75 2\nsome key:=some value\n";
+          std::string path;
+          if (detached) {
+            head += "data file: vol.raw\n";
+            test::write_bytes(dir.file("vol.raw"), data);
+            path = dir.file("vol.nhdr");
+            test::write_bytes(path, text_bytes(head));
+          } else {
+            auto file = text_bytes(head + "\n");
+            file.insert(file.end(), data.begin(), data.end());
+            path = dir.file("vol.nrrd");
+            test::write_bytes(path, file);
+          }
+          const auto src = open_source(path, BrickLayout{glm::uvec3(4), 1});
+          const VolumeDesc& d = src->volume();
+          EXPECT_EQ(d.extent, e);
+          EXPECT_EQ(d.spacing, glm::dvec3(0.5, 0.75, 2));
+          EXPECT_EQ(d.type, type == "uchar"    ? VoxelType::u8
+                            : type == "ushort" ? VoxelType::u16
+                                               : VoxelType::f32);
+          const auto v = level0(*src, 0);
+          for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(v[i], sample_value(type, i)) << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(Nrrd, ChannelAxesSpaceDirectionsAndSkips) {
+  TempDir dir;
+  // 4-D with the first axis a vector of 3 channels (interleaved), directions give spacing.
+  std::vector<std::uint8_t> data;
+  for (std::size_t i = 0; i < 3 * 24; ++i) data.push_back(std::uint8_t(i));
+  auto file = text_bytes(
+      "NRRD0005\ntype: uint8\ndimension: 4\nsizes: 3 4 3 2\nkinds: vector domain domain "
+      "domain\nencoding: raw\nspace dimension: 3\nspace directions: none (0,1.5,0) (2,0,0) "
+      "(0,0,-3)\n\n");
+  file.insert(file.end(), data.begin(), data.end());
+  test::write_bytes(dir.file("vec.nrrd"), file);
+  const auto vec = open_source(dir.file("vec.nrrd"), BrickLayout{glm::uvec3(4), 1});
+  EXPECT_EQ(vec->volume().channels, 3u);
+  EXPECT_EQ(vec->volume().extent, glm::u64vec3(4, 3, 2));
+  EXPECT_EQ(vec->volume().spacing, glm::dvec3(1.5, 2, 3));
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    const auto v = level0(*vec, c);
+    for (std::size_t i = 0; i < 24; ++i) ASSERT_EQ(v[i], double(i * 3 + c));
+  }
+  // 4-D with the last axis 2 channels one after another; a detached file with line and byte
+  // skips before the data.
+  std::vector<std::uint8_t> skipped = text_bytes("junk line 1\njunk line 2\nXYZ");
+  for (std::size_t i = 0; i < 2 * 8; ++i) append_sample(skipped, "ushort", double(i * 1000), true);
+  test::write_bytes(dir.file("t.bin"), skipped);
+  test::write_bytes(dir.file("t.nhdr"),
+                    text_bytes("NRRD0004\ntype: unsigned short\ndimension: 4\nsizes: 2 2 2 "
+                               "2\nendian: big\nencoding: raw\nline skip: 2\nbyte skip: 3\n"
+                               "datafile: t.bin\n"));
+  const auto t = open_source(dir.file("t.nhdr"), BrickLayout{glm::uvec3(4), 1});
+  EXPECT_EQ(t->volume().channels, 2u);
+  for (std::uint32_t c = 0; c < 2; ++c) {
+    const auto v = level0(*t, c);
+    for (std::size_t i = 0; i < 8; ++i) ASSERT_EQ(v[i], double((c * 8 + i) * 1000));
+  }
+  // byte skip -1: the data are the last bytes of the file.
+  auto tail = text_bytes(
+      "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 3 2\nencoding: raw\n"
+      "byte skip: -1\n\n0123456789");
+  test::write_bytes(dir.file("tail.nrrd"), tail);
+  const auto s2 = open_source(dir.file("tail.nrrd"), BrickLayout{glm::uvec3(4), 1});
+  EXPECT_EQ(s2->volume().extent, glm::u64vec3(3, 2, 1));
+  EXPECT_EQ(level0(*s2, 0), (std::vector<double>{'4', '5', '6', '7', '8', '9'}));
+}
+
+TEST(Nrrd, MalformedHeadersAndFiles) {
+  auto parse = [](const std::string& s) { return parse_nrrd_header(s, "h.nrrd"); };
+  const std::string ok = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n";
+  EXPECT_NO_THROW(parse(ok));
+  EXPECT_RESOCT_ERROR(parse("NRRX0004\n"), ErrorCode::bad_magic, "h.nrrd");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n\n"),
+                      ErrorCode::corrupt, "'encoding' is missing");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: double\ndimension: 1\nsizes: 2\nencoding: raw\n\n"),
+                      ErrorCode::unsupported, "offset 9: NRRD field 'type'");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2\nencoding: raw\n\n"),
+                      ErrorCode::corrupt, "NRRD field 'sizes'");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 0 2\nencoding: raw\n\n"),
+                      ErrorCode::corrupt, ">= 1");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: "
+                            "bzip2\n\n"),
+                      ErrorCode::unsupported, "encoding");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 5\nsizes: 2 2 2 2 2\nencoding: "
+                            "raw\n\n"),
+                      ErrorCode::unsupported, "dimension");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: x\nsizes: 2\nencoding: raw\n\n"),
+                      ErrorCode::corrupt, "integer");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\nthis line has no separator\n\n"), ErrorCode::corrupt,
+                      "offset 9");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 1\nsizes: 2\nencoding: raw\n"
+                            "data file: LIST\n\n"),
+                      ErrorCode::unsupported, "data file");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+                            "space directions: (1,0,0) (0,1,0) (0,0,q)\n\n"),
+                      ErrorCode::corrupt, "space directions");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: "
+                            "raw\nendian: middle\n\n"),
+                      ErrorCode::corrupt, "endian");
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 2\nsizes: 60000000000 "
+                            "60000000000\nencoding: raw\n\n"),
+                      ErrorCode::overflow, "sizes");
+
+  TempDir dir;
+  auto file = text_bytes(ok);
+  file.insert(file.end(), 7, 1);  // one byte short
+  test::write_bytes(dir.file("short.nrrd"), file);
+  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("short.nrrd")), ErrorCode::truncated, "short.nrrd");
+  auto gz = text_bytes("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n");
+  auto packed = gzip(std::vector<std::uint8_t>(8, 3));
+  packed.resize(packed.size() - 10);
+  gz.insert(gz.end(), packed.begin(), packed.end());
+  test::write_bytes(dir.file("cut.nrrd"), gz);
+  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("cut.nrrd")), ErrorCode::size_mismatch, "cut.nrrd");
+  test::write_bytes(dir.file("d.nhdr"),
+                    text_bytes("NRRD0004\ntype: uchar\ndimension: 1\nsizes: 4\nencoding: "
+                               "raw\ndata file: missing.raw\n"));
+  EXPECT_RESOCT_ERROR(open_nrrd(dir.file("d.nhdr")), ErrorCode::io, "missing.raw");
+}
+
+}  // namespace

@@ -1,0 +1,198 @@
+// OME-Zarr images written by the reference implementation (zarr-python + numcodecs, generated
+// by tests/data/make_ome_zarr.py at test time) against the same numpy arrays written as raw:
+// every compressor x dtype x chunking x axis subset, multiscales with stored and computed
+// levels, missing chunks (fill_value) and omero windows.
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "resoct/formats/ome_zarr.hpp"
+#include "resoct/in_memory_source.hpp"
+#include "support/brick_compare.hpp"
+#include "support/generated_data.hpp"
+#include "support/tool_process.hpp"
+
+using namespace resoct;
+
+namespace {
+
+const std::string& data_dir() {
+  static const std::string dir = test::python_generated_dir(
+      RESOCT_BINARY_DIR "/test-data", "ome-zarr", RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr.py");
+  return dir;
+}
+
+const nlohmann::json& manifest() {
+  static const nlohmann::json m = nlohmann::json::parse(test::slurp(data_dir() + "/manifest.json"));
+  return m;
+}
+
+nlohmann::json find_case(const std::string& name) {
+  for (const auto& c : manifest()["cases"]) {
+    if (c["name"] == name) return c;
+  }
+  ADD_FAILURE() << "no case " << name;
+  return {};
+}
+
+/// The level-0 voxels of one (t, c) from the raw dump of the numpy array (all axes, C order,
+/// little-endian), as resoct lays them out: x fastest, then y, then z.
+std::vector<std::byte> expected_voxels(const nlohmann::json& c, std::uint64_t t,
+                                       std::uint64_t channel) {
+  const std::string axes = c["axes"];
+  const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
+  const std::string dtype = c["dtype"];
+  const std::size_t vs = dtype.substr(1) == "u1" ? 1 : dtype.substr(1) == "u2" ? 2 : 4;
+  const std::string raw = test::slurp(data_dir() + "/" + std::string(c["name"]) + ".raw");
+  std::uint64_t total = 1;
+  for (auto s : shape) total *= s;
+  EXPECT_EQ(raw.size(), total * vs);
+  // C-order strides of the full array.
+  std::vector<std::uint64_t> stride(shape.size(), 1);
+  for (std::size_t i = shape.size() - 1; i > 0; --i) stride[i - 1] = stride[i] * shape[i];
+  auto dim = [&](char a) -> std::int64_t {
+    const auto p = axes.find(a);
+    return p == std::string::npos ? -1 : std::int64_t(p);
+  };
+  auto extent = [&](char a) { return dim(a) < 0 ? 1 : shape[std::size_t(dim(a))]; };
+  auto step = [&](char a) { return dim(a) < 0 ? 0 : stride[std::size_t(dim(a))]; };
+  const std::uint64_t base = t * step('t') + channel * step('c');
+  std::vector<std::byte> out;
+  for (std::uint64_t z = 0; z < extent('z'); ++z)
+    for (std::uint64_t y = 0; y < extent('y'); ++y)
+      for (std::uint64_t x = 0; x < extent('x'); ++x) {
+        const std::uint64_t i = base + z * step('z') + y * step('y') + x * step('x');
+        for (std::size_t b = 0; b < vs; ++b) out.push_back(std::byte(raw[i * vs + b]));
+      }
+  return out;
+}
+
+/// An InMemorySource over the expected voxels with the zarr source's description: the
+/// brute-force reference for every brick of every level (coarse levels computed eagerly).
+InMemorySource reference(const nlohmann::json& c, const BrickSource& zarr, std::uint64_t t,
+                         const BrickLayout& layout) {
+  std::vector<std::byte> all;
+  for (std::uint32_t ch = 0; ch < zarr.volume().channels; ++ch) {
+    const auto v = expected_voxels(c, t, ch);
+    all.insert(all.end(), v.begin(), v.end());
+  }
+  return InMemorySource(DenseVolume::from_bytes(zarr.volume(), std::move(all)), layout, 16, "ref");
+}
+
+TEST(OmeZarr, EveryCompressorDtypeChunkingAndAxisSubset) {
+  ASSERT_FALSE(data_dir().empty());
+  const auto& cases = manifest()["cases"];
+  ASSERT_GE(cases.size(), 400u);
+  std::size_t checked = 0;
+  const BrickLayout layout{glm::uvec3(4), 1};
+  for (const auto& c : cases) {
+    const std::string name = c["name"];
+    if (name.starts_with("pyramid") || name.starts_with("fill") || name == "omero") continue;
+    SCOPED_TRACE(name);
+    const std::string axes = c["axes"];
+    const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
+    const std::uint64_t times = axes.find('t') == std::string::npos ? 1 : shape[axes.find('t')];
+    for (std::uint64_t t = 0; t < times; ++t) {
+      OmeZarrOptions o;
+      o.timepoint = t;
+      o.pyramid.threads = 1;
+      const auto src = open_ome_zarr(data_dir() + "/" + name + ".zarr", layout, o);
+      const VolumeDesc& d = src->volume();
+      const std::uint64_t channels =
+          axes.find('c') == std::string::npos ? 1 : shape[axes.find('c')];
+      ASSERT_EQ(d.channels, channels);
+      for (char a : std::string("xyz")) {
+        const auto p = axes.find(a);
+        const int i = a - 'x';
+        EXPECT_EQ(d.extent[i], p == std::string::npos ? 1u : shape[p]);
+        EXPECT_EQ(d.spacing[i], p == std::string::npos ? 1.0 : a == 'z' ? 2.0 : 0.5);
+      }
+      for (std::uint32_t ch = 0; ch < d.channels; ++ch) {
+        const auto want = expected_voxels(c, t, ch);
+        std::vector<std::byte> got(want.size());
+        src->read_level_box(0, ch, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, got);
+        ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0) << "t " << t << " c " << ch;
+      }
+      // Every brick with halo and every coarser level against the brute-force reference.
+      test::expect_same_bricks(reference(c, *src, t, layout), *src);
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 400u);
+}
+
+TEST(OmeZarr, StoredLevelsServeTheHierarchyAndMissingOnesAreBuilt) {
+  for (const std::string name : {"pyramid_u2", "pyramid_f4"}) {
+    SCOPED_TRACE(name);
+    const auto c = find_case(name);
+    const BrickLayout layout{glm::uvec3(8), 1};
+    const auto src = open_ome_zarr(data_dir() + "/" + name + ".zarr", layout);
+    ASSERT_EQ(src->hierarchy().level_count(), 4u);
+    EXPECT_EQ(src->dataset_of_level(0), 0);
+    EXPECT_EQ(src->dataset_of_level(1), 1);
+    EXPECT_EQ(src->dataset_of_level(2), 2);
+    EXPECT_EQ(src->dataset_of_level(3), -1);
+    EXPECT_TRUE(src->stored_level(2));
+    EXPECT_FALSE(src->stored_level(3));
+    // The file's levels were written with resoct's rule, so stored and computed levels alike
+    // equal whole-level downsampling of level 0.
+    test::expect_same_bricks(reference(c, *src, 0, layout), *src);
+    EXPECT_GT(src->chunk_cache_stats().hits, 0u);
+  }
+}
+
+TEST(OmeZarr, MissingChunksReadAsFillValue) {
+  for (const std::string name : {"fill_u1", "fill_f4"}) {
+    SCOPED_TRACE(name);
+    const auto c = find_case(name);
+    const std::string dir = data_dir() + "/" + name + ".zarr";
+    // The far corner chunk was never written (the assertion keeps the test meaningful).
+    EXPECT_FALSE(std::filesystem::exists(dir + "/0/2/3/3"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/0/0/0/0"));
+    const auto src = open_ome_zarr(dir, BrickLayout{glm::uvec3(4), 1});
+    const auto want = expected_voxels(c, 0, 0);
+    std::vector<std::byte> got(want.size());
+    src->read_level_box(0, 0, Box3{glm::i64vec3(0), glm::i64vec3(src->volume().extent)}, got);
+    ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0);
+    const double fill = c["fill"];
+    float last;  // the last voxel lies in an unwritten chunk
+    if (name == "fill_f4") {
+      std::memcpy(&last, got.data() + got.size() - 4, 4);
+      EXPECT_EQ(double(last), fill);
+    } else {
+      EXPECT_EQ(double(std::uint8_t(got.back())), fill);
+    }
+  }
+}
+
+TEST(OmeZarr, OmeroWindowsAreChannelRanges) {
+  const auto src = open_ome_zarr(data_dir() + "/omero.zarr", BrickLayout{glm::uvec3(4), 1});
+  EXPECT_EQ(src->volume().range(0), (ValueRange{100.0, 4000.0}));
+  EXPECT_EQ(src->volume().range(1), (ValueRange{0.0, 65535.0}));
+  ASSERT_EQ(src->multiscales().channels.size(), 2u);
+  EXPECT_EQ(src->multiscales().channels[0].label, "DAPI");
+  EXPECT_EQ(src->multiscales().channels[1].color, "00FF00");
+  EXPECT_EQ(src->array(0).compressor, ZarrCompressor::zlib);
+}
+
+TEST(OmeZarr, RangesFromDataWithoutOmero) {
+  const auto c = find_case("zstd_lef4_small_zyx");
+  const auto src = open_ome_zarr(data_dir() + "/zstd_lef4_small_zyx.zarr");
+  const auto v = expected_voxels(c, 0, 0);
+  float lo = 1e30f, hi = -1e30f;
+  for (std::size_t i = 0; i < v.size(); i += 4) {
+    float f;
+    std::memcpy(&f, v.data() + i, 4);
+    if (f == f) lo = std::min(lo, f), hi = std::max(hi, f);
+  }
+  EXPECT_EQ(src->volume().range(0), (ValueRange{double(lo), double(hi)}));
+}
+
+}  // namespace
