@@ -1,13 +1,13 @@
 // Frames to convergence on a scripted camera path, with and without prefetching (paper 001's
-// predictive paging by linear extrapolation). The camera orbits the volume by `step` degrees per
-// frame for `path` frames and then stops; frames are paced at a fixed period (an interactive
-// display loop that does not wait for loads), and every brick read costs a fixed latency (a slow
-// disk or a remote server). Counters:
+// predictive paging by linear extrapolation). The camera orbits the volume (path 0, 5 degrees a
+// frame) or flies towards its centre (path 1) for 24 frames and then stops; frames are paced at
+// a fixed period (an interactive display loop that does not wait for loads), and every brick
+// read costs a fixed latency (a slow disk or a remote server). Counters:
 //   unconverged_on_path  frames along the path whose image still lacked bricks
 //   frames_after_stop    frames after the camera stopped until the image converged
 //   missing_requests     device brick requests summed over the path (how much was missing)
 //   prefetched, prefetch_hits  bricks read ahead, and requests those reads served
-// Arg: lookahead frames (0 = prefetching off). One iteration per run (a cold renderer).
+// Args: lookahead frames (0 = prefetching off), path. One iteration per run (a cold renderer).
 // RESOCT_BENCH_SMOKE=1: a short path, no latency.
 
 #include <benchmark/benchmark.h>
@@ -72,15 +72,27 @@ Camera orbit(const Camera& c, double deg) {
   return out;
 }
 
+/// Pose of frame f (held at the last pose after the path): kind 0 orbits the volume centre by
+/// 5 degrees a frame; kind 1 flies towards the centre, from 1.0 to 0.45 of the start distance,
+/// so that ever finer levels come into view.
+Camera pose(const Camera& start, int kind, std::uint32_t f, std::uint32_t path) {
+  const double u = double(std::min(f, path - 1));
+  if (kind == 0) return orbit(start, 5.0 * u);
+  Camera c = start;
+  const double s = 1.0 - 0.55 * u / double(path - 1);
+  c.eye = start.target + s * (start.eye - start.target);
+  return c;
+}
+
 void BM_PrefetchPath(benchmark::State& state) {
   const auto lookahead = std::uint32_t(state.range(0));
+  const int kind = int(state.range(1));
   const bool tiny = smoke();
   // The period exceeds the render time of a 32x32 frame even on a loaded machine, so that loading,
   // not rendering, limits progress: one loader thread at 8 ms per brick
   // (RESOCT_PREFETCH_LATENCY_US) reads about 30 bricks a frame, a little more than the orbit needs
   // anew per frame, so prefetching has idle reads to use.
   const std::uint32_t path = tiny ? 4 : 24;
-  const double step_deg = 5.0;
   const auto period = std::chrono::milliseconds(tiny ? 1 : 250);
   const char* env_latency = std::getenv("RESOCT_PREFETCH_LATENCY_US");
   const auto latency = std::chrono::microseconds(tiny          ? 0
@@ -111,7 +123,7 @@ void BM_PrefetchPath(benchmark::State& state) {
     for (; f < path + 200 && !done; ++f) {
       const auto t0 = std::chrono::steady_clock::now();
       Scene s = scene;
-      s.camera = orbit(scene.camera, step_deg * double(std::min(f, path - 1)));
+      s.camera = pose(scene.camera, kind, f, path);
       const FrameReport rep = r.render_frame(s);
       if (f < path) {
         unconverged += rep.converged ? 0 : 1;
@@ -135,16 +147,15 @@ void BM_PrefetchPath(benchmark::State& state) {
   state.counters["prefetch_hits"] = hits / n;
   state.counters["path_frames"] = path;
   state.counters["converged"] = converged / n;
-  state.SetLabel(lookahead == 0 ? "no prefetch" : "prefetch");
+  state.SetLabel(std::string(kind == 0 ? "orbit" : "dolly") +
+                 (lookahead == 0 ? ", no prefetch" : ", prefetch"));
 }
 
 }  // namespace
 
 BENCHMARK(BM_PrefetchPath)
-    ->ArgName("lookahead")
-    ->Arg(0)
-    ->Arg(2)
-    ->Arg(4)
+    ->ArgNames({"lookahead", "path"})
+    ->ArgsProduct({{0, 2, 4}, {0, 1}})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

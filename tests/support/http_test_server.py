@@ -91,15 +91,21 @@ class Handler(http.server.BaseHTTPRequestHandler):
         if mode == "stall":
             time.sleep(60)
             return
-        with open(path, "rb") as f:
-            data = f.read()
+        size = os.path.getsize(path)
+
+        def read(first, count):
+            # Only the bytes sent: whole-file reads would make every range request cost the file.
+            with open(path, "rb") as f:
+                f.seek(first)
+                return f.read(count)
+
         if mode == "truncate":
             self.send_response(200)
-            self.send_header("Content-Length", str(len(data)))
+            self.send_header("Content-Length", str(size))
             self.send_header("Connection", "close")
             self.end_headers()
             if send_body:
-                self.wfile.write(data[: len(data) // 2])
+                self.wfile.write(read(0, size // 2))
                 self.wfile.flush()
             self.close_connection = True
             return
@@ -107,19 +113,23 @@ class Handler(http.server.BaseHTTPRequestHandler):
             return self.send_bytes(400, b"unknown mode", send_body=send_body)
         rng = self.headers.get("Range")
         if mode == "norange" or rng is None:
-            return self.send_bytes(200, data, [("Accept-Ranges", "bytes")], send_body)
+            if not send_body:  # HEAD: the size without reading the file
+                self.send_response(200)
+                self.send_header("Content-Length", str(size))
+                self.send_header("Accept-Ranges", "bytes")
+                self.end_headers()
+                return
+            return self.send_bytes(200, read(0, size), [("Accept-Ranges", "bytes")])
         m = re.fullmatch(r"bytes=(\d+)-(\d*)", rng.strip())
         if not m:
             return self.send_bytes(400, b"bad range", send_body=send_body)
         first = int(m.group(1))
-        last = int(m.group(2)) if m.group(2) else len(data) - 1
-        if first >= len(data):
-            return self.send_bytes(416, b"", [("Content-Range", "bytes */%d" % len(data))],
-                                   send_body)
-        last = min(last, len(data) - 1)
-        self.send_bytes(206, data[first:last + 1],
-                        [("Content-Range", "bytes %d-%d/%d" % (first, last, len(data)))],
-                        send_body)
+        last = int(m.group(2)) if m.group(2) else size - 1
+        if first >= size:
+            return self.send_bytes(416, b"", [("Content-Range", "bytes */%d" % size)], send_body)
+        last = min(last, size - 1)
+        self.send_bytes(206, read(first, last + 1 - first),
+                        [("Content-Range", "bytes %d-%d/%d" % (first, last, size))], send_body)
 
 
 class Server(http.server.ThreadingHTTPServer):
