@@ -12,6 +12,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -93,7 +94,10 @@ void BM_PrefetchPath(benchmark::State& state) {
   // (RESOCT_PREFETCH_LATENCY_US) reads about 30 bricks a frame, a little more than the orbit needs
   // anew per frame, so prefetching has idle reads to use.
   const std::uint32_t path = tiny ? 4 : 24;
-  const auto period = std::chrono::milliseconds(tiny ? 1 : 250);
+  const char* env_period = std::getenv("RESOCT_PREFETCH_PERIOD_MS");
+  const auto period = std::chrono::milliseconds(tiny         ? 1
+                                                : env_period ? std::atol(env_period)
+                                                             : 250);
   const char* env_latency = std::getenv("RESOCT_PREFETCH_LATENCY_US");
   const auto latency = std::chrono::microseconds(tiny          ? 0
                                                  : env_latency ? std::atol(env_latency)
@@ -104,6 +108,7 @@ void BM_PrefetchPath(benchmark::State& state) {
   scene.camera.eye = scene.camera.target + 0.75 * (scene.camera.eye - scene.camera.target);
 
   double unconverged = 0, after_stop = 0, missing = 0, prefetched = 0, hits = 0, converged = 0;
+  double render_ms = 0, frames = 0;
   for (auto _ : state) {
     auto src = std::make_shared<SlowSource>(
         make_procedural_source(
@@ -125,6 +130,8 @@ void BM_PrefetchPath(benchmark::State& state) {
       Scene s = scene;
       s.camera = pose(scene.camera, kind, f, path);
       const FrameReport rep = r.render_frame(s);
+      render_ms += rep.stats.ms_frame;
+      frames += 1;
       if (f < path) {
         unconverged += rep.converged ? 0 : 1;
         missing += double(rep.stats.brick_requests);
@@ -147,6 +154,8 @@ void BM_PrefetchPath(benchmark::State& state) {
   state.counters["prefetch_hits"] = hits / n;
   state.counters["path_frames"] = path;
   state.counters["converged"] = converged / n;
+  // Above the period, rendering rather than loading limited the run (a loaded machine).
+  state.counters["ms_per_frame"] = render_ms / std::max(1.0, frames);
   state.SetLabel(std::string(kind == 0 ? "orbit" : "dolly") +
                  (lookahead == 0 ? ", no prefetch" : ", prefetch"));
 }

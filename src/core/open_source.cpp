@@ -97,6 +97,10 @@ std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout
 /// An http(s) URL: an OME-Zarr image when a URL map is given or the URL has zarr metadata below
 /// it, else a brick store file read by Range requests.
 std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout& layout) {
+  if (spec.find_first_of("?#") != std::string::npos) {
+    throw invalid_parameter("spec",
+                            "URL '" + spec + "' has a query or fragment, which is unsupported");
+  }
   std::shared_ptr<const HttpStore> store = open_http_store(spec);
   if (spec.find(',') != std::string::npos || store->size(".zattrs") || store->size(".zarray")) {
     return open_ome_zarr(store, layout);
