@@ -21,7 +21,7 @@ TEST(HttpRender, ImagesEqualTheLocalStoreFrameByFrame) {
   test::HttpTestServer server(test::HttpTestServer::default_script(), dir.path().string());
 
   Scene scene = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/tubes.json");
-  scene.viewport = Viewport{40, 40};
+  scene.viewport = Viewport{28, 28};
   cpu::register_backend();
   RendererOptions o;
   o.backend = "cpu";

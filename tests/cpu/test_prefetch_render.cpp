@@ -53,7 +53,7 @@ TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
   std::shared_ptr<const BrickSource> src =
       make_procedural_source("procedural:tubes:64x64x64", BrickLayout{glm::uvec3(8), 1});
   for (const double lod_px : {1.0, 3.0}) {
-    Scene scene = tubes_scene(48);
+    Scene scene = tubes_scene(36);
     scene.lod_error_px = lod_px;
     RendererOptions o = sync_options();
     o.strategy = RequestStrategy::global;  // only the bricks the samples need, no ancestors
@@ -85,7 +85,7 @@ TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
 TEST(PrefetchRender, ChangesNoImageAndServesLaterRequests) {
   std::shared_ptr<const BrickSource> src =
       make_procedural_source("procedural:tubes:64x64x64", BrickLayout{glm::uvec3(8), 1});
-  const Scene base = tubes_scene(32);
+  const Scene base = tubes_scene(24);
   RendererOptions plain = sync_options();
   plain.upload_budget.max_bricks = 6;  // several frames per pose: the path outruns the loads
   RendererOptions ahead = plain;
@@ -93,7 +93,7 @@ TEST(PrefetchRender, ChangesNoImageAndServesLaterRequests) {
   ahead.prefetch.max_bricks = 16;
   Renderer a(src, plain), b(src, ahead);
   std::uint64_t queued = 0;
-  for (int f = 0; f < 14; ++f) {
+  for (int f = 0; f < 10; ++f) {
     Scene s = base;
     s.camera = orbit(base.camera, 6.0 * f);
     const FrameReport ra = a.render_frame(s);

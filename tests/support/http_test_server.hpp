@@ -5,6 +5,7 @@
 // standard input closes, so it dies with the test process even when that is killed.
 
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
