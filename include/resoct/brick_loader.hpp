@@ -116,6 +116,7 @@ class BrickLoader {
   bool idle() const;
 
   HostBrickCache& host_cache() noexcept { return cache_; }
+  const HostBrickCache& host_cache() const noexcept { return cache_; }
   BrickLoaderStats stats() const;
 
  private:
