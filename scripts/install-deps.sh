@@ -13,6 +13,8 @@ PACKAGES=(
   python3-matplotlib
   # formats tests: OME-Zarr written by the reference implementation, real MRI volumes
   python3-zarr python3-numcodecs python3-numpy mricron-data
+  # HTTP tests and bench_http: /usr/bin/python3 runs tests/support/http_test_server.py
+  python3
 )
 
 missing=()

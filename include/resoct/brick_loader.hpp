@@ -6,8 +6,10 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <thread>
@@ -17,6 +19,7 @@
 
 #include "resoct/brick_key.hpp"
 #include "resoct/brick_source.hpp"
+#include "resoct/eviction_policy.hpp"
 #include "resoct/host_brick_cache.hpp"
 
 namespace resoct {
@@ -53,6 +56,8 @@ struct BrickLoaderStats {
   std::uint64_t failures = 0;    ///< distinct bricks that failed
   std::uint64_t cancelled = 0;   ///< queued requests dropped because a newer list omitted them
   std::uint64_t duplicates = 0;  ///< requests ignored: already queued, in flight, ready or failed
+  std::uint64_t prefetched = 0;  ///< bricks read into the host cache by prefetch()
+  std::uint64_t prefetch_hits = 0;  ///< requests served by the host cache thanks to a prefetch
 };
 
 /// Loading order: coarser level first, then lower channel rank, then older (smaller `since`),
@@ -61,14 +66,18 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 
 /// Loads bricks in priority order. request() replaces the set of queued (not yet started)
 /// requests; bricks already in flight finish and are delivered; a key is queued, loading or ready
-/// at most once; a key that failed is never loaded again. With 0 threads nothing happens in the
-/// background and run_queued() loads on the calling thread, which makes tests deterministic.
+/// at most once; a key that failed is never loaded again. prefetch() keeps a second, lower
+/// priority queue whose bricks go into the host cache only (a worker takes one only while no
+/// request is queued). With 0 threads nothing happens in the background and run_queued() /
+/// run_prefetch() load on the calling thread, which makes tests deterministic.
 /// Thread-safety: all members may be called from any thread; the worker threads are internal.
 class BrickLoader {
  public:
   /// Throws Error(invalid_argument) naming "source" when it is null or "threads" above 1024.
+  /// `host_policy` orders host cache evictions (null: LRU).
   BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
-              std::uint64_t host_cache_bytes);
+              std::uint64_t host_cache_bytes,
+              std::unique_ptr<EvictionPolicy> host_policy = nullptr);
   /// Stops the workers after their current brick; queued requests are dropped.
   ~BrickLoader();
   BrickLoader(const BrickLoader&) = delete;
@@ -82,7 +91,16 @@ class BrickLoader {
   void request(std::span<const LoadRequest> wanted);
   /// Loads up to `max` queued bricks on the calling thread, best first; returns how many.
   std::size_t run_queued(std::size_t max);
-  /// Blocks until nothing is queued or in flight (for tools and tests with threads).
+  /// Replaces the prefetch queue with `keys` (best first). Keys already in the host cache,
+  /// queued, in flight, ready or failed are skipped. A prefetched brick goes into the host cache
+  /// only; if a request() for it arrives while it loads, it is delivered like a requested one.
+  /// A prefetch that fails marks the key failed and is reported like a failed request.
+  void prefetch(std::span<const BrickKey> keys);
+  /// Loads up to `max` prefetch keys on the calling thread; returns how many were loaded.
+  std::size_t run_prefetch(std::size_t max);
+  std::size_t prefetch_queued() const;
+  /// Blocks until nothing is queued or in flight, prefetches included (for tools and tests with
+  /// threads).
   void wait_idle();
 
   /// Loaded bricks not yet taken, in load_before order; the ready list is emptied.
@@ -94,18 +112,25 @@ class BrickLoader {
   std::size_t queued() const;
   std::size_t in_flight() const;
   std::size_t ready() const;
-  /// Nothing queued, in flight or ready.
+  /// Nothing queued, in flight or ready (prefetches do not count: they change no image).
   bool idle() const;
 
   HostBrickCache& host_cache() noexcept { return cache_; }
+  const HostBrickCache& host_cache() const noexcept { return cache_; }
   BrickLoaderStats stats() const;
 
  private:
   void worker_main();
   /// Pops the best queued request; caller holds mutex_ and the queue is not empty.
   LoadRequest pop_locked();
+  /// Pops the next prefetch key still worth loading and marks it loading; caller holds mutex_.
+  std::optional<BrickKey> pop_prefetch_locked();
   /// Loads one brick without holding mutex_ and files the result.
   void load_one(const LoadRequest& r);
+  /// Reads a brick into the host cache; the failure message when it throws.
+  std::shared_ptr<const HostBrick> read_brick(BrickKey key, std::string& failure);
+  /// Loads one prefetch key without holding mutex_.
+  void prefetch_one(BrickKey key);
 
   std::shared_ptr<const BrickSource> source_;
   HostBrickCache cache_;
@@ -118,6 +143,11 @@ class BrickLoader {
   std::unordered_set<BrickKey> in_flight_;
   std::unordered_map<BrickKey, LoadedBrick> ready_;
   std::unordered_set<BrickKey> failed_;
+  std::deque<BrickKey> prefetch_;  // front loads first
+  std::unordered_set<BrickKey> prefetching_;
+  std::unordered_set<BrickKey> prefetched_;  // in the host cache by prefetch, not yet requested
+  // Requested while their prefetch was loading: delivered when it completes, not read twice.
+  std::unordered_map<BrickKey, LoadRequest> adopted_;
   std::vector<LoadFailure> new_failures_;
   BrickLoaderStats stats_;
   std::vector<std::thread> workers_;

@@ -15,6 +15,7 @@
 
 #include "resoct/brick_source.hpp"
 #include "resoct/codec.hpp"
+#include "resoct/random_access_file.hpp"
 
 namespace resoct {
 
@@ -78,7 +79,7 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
 /// index and the metadata section (magic, version, checksums, field sanity, every payload
 /// range inside the file); read_brick() then verifies each payload's checksum and size.
 /// Thread-safety: all member functions may be called from any number of threads at once
-/// (reads use pread; nothing shares a file position).
+/// (reads use pread or independent HTTP requests; nothing shares a file position).
 class BrickStoreSource final : public BrickSource {
  public:
   /// Opens and validates `path`. Throws resoct::Error with a code per failure class (io,
@@ -86,6 +87,10 @@ class BrickStoreSource final : public BrickSource {
   /// overflow, unsupported, size_mismatch, decompress_failed) and a message naming the file and
   /// the byte offset.
   explicit BrickStoreSource(const std::string& path);
+  /// Opens and validates a store read through `file` (a local file, or an HTTP object read by
+  /// Range requests: open_random_access_file()); name() is then file->path(). Throws as above,
+  /// naming file->path(), and Error(invalid_argument) naming "file" when it is null.
+  explicit BrickStoreSource(std::unique_ptr<RandomAccessFile> file);
   ~BrickStoreSource() override;
   BrickStoreSource(const BrickStoreSource&) = delete;
   BrickStoreSource& operator=(const BrickStoreSource&) = delete;
@@ -99,7 +104,7 @@ class BrickStoreSource final : public BrickSource {
   BrickMeta brick_meta(BrickKey key) const override;
   /// From the stored level-0 metadata pyramid. Throws invalid_parameter for a bad channel.
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
-  /// The path the store was opened from.
+  /// The path or URL the store was opened from.
   std::string name() const override;
 
   /// Per-level statistics, computed from the index at open.

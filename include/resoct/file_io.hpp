@@ -10,11 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "resoct/random_access_file.hpp"
+
 namespace resoct {
 
 /// A file opened for reading. Move-only; closes on destruction.
 /// Thread-safety: read_at() and size() may be called from any number of threads at once.
-class ReadFile {
+class ReadFile final : public RandomAccessFile {
  public:
   /// Opens `path`; throws Error(io) naming the path when it does not exist or cannot be read.
   explicit ReadFile(std::string path);
@@ -22,16 +24,16 @@ class ReadFile {
   ReadFile& operator=(ReadFile&& o) noexcept;
   ReadFile(const ReadFile&) = delete;
   ReadFile& operator=(const ReadFile&) = delete;
-  ~ReadFile();
+  ~ReadFile() override;
 
-  const std::string& path() const noexcept { return path_; }
+  const std::string& path() const noexcept override { return path_; }
   /// Size in bytes at the time of opening.
-  std::uint64_t size() const noexcept { return size_; }
+  std::uint64_t size() const noexcept override { return size_; }
 
   /// Reads exactly out.size() bytes starting at `offset` (pread). Throws
   /// file_error(truncated, path, offset, ...) when the file ends first and Error(io) when the
   /// operating system fails.
-  void read_at(std::uint64_t offset, std::span<std::byte> out) const;
+  void read_at(std::uint64_t offset, std::span<std::byte> out) const override;
 
  private:
   std::string path_;

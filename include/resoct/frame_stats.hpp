@@ -26,6 +26,7 @@ struct FrameStats {
   // Loading and uploads (applied at the start of this frame).
   std::uint64_t loads_queued = 0;     ///< loader queue after this frame's request
   std::uint64_t loads_in_flight = 0;  ///< bricks being read when the frame ended
+  std::uint64_t prefetch_queued = 0;  ///< bricks queued for prefetching this frame
   std::uint64_t bricks_uploaded = 0;  ///< cache slots written
   std::uint64_t bytes_uploaded = 0;
   std::uint64_t pages_empty = 0;        ///< bricks mapped EMPTY (all zero) this frame

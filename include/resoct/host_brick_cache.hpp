@@ -6,14 +6,15 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <list>
 #include <memory>
 #include <mutex>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
 #include "resoct/brick_key.hpp"
 #include "resoct/brick_source.hpp"
+#include "resoct/eviction_policy.hpp"
 
 namespace resoct {
 
@@ -32,30 +33,43 @@ struct HostBrickCacheStats {
   std::uint64_t evictions = 0;
 };
 
-/// LRU cache of HostBricks bounded by bytes. Each entry costs its voxel bytes plus
-/// kEntryOverhead (so constant bricks are bounded too). A brick larger than the whole capacity
-/// is not kept. Entries are shared_ptr<const>, so a brick handed out stays valid after eviction.
-/// Thread-safety: every member may be called from any number of threads at once (one mutex).
+/// Cache of HostBricks bounded by bytes, with a pluggable EvictionPolicy (LruPolicy by default;
+/// OctreemizerPolicy for the discard priority of paper 001). Each entry costs its voxel bytes plus
+/// kEntryOverhead (so constant bricks are bounded too). A brick larger than the whole capacity is
+/// not kept. Entries are shared_ptr<const>, so a brick handed out stays valid after eviction.
+/// The policy sees each entry as a slot; nothing is pinned except the brick being inserted (a
+/// host entry has no device copy in flight), and its ages are counted in the frames given by
+/// set_frame(). Thread-safety: every member may be called from any number of threads at once
+/// (one mutex, held while the policy runs).
 class HostBrickCache {
  public:
   /// Accounted bytes of bookkeeping per entry.
   static constexpr std::uint64_t kEntryOverhead = 64;
 
-  /// `capacity_bytes` 0 disables caching (put() keeps nothing).
-  explicit HostBrickCache(std::uint64_t capacity_bytes);
+  /// `capacity_bytes` 0 disables caching (put() keeps nothing). A null `policy` means LRU.
+  explicit HostBrickCache(std::uint64_t capacity_bytes,
+                          std::unique_ptr<EvictionPolicy> policy = nullptr);
+  ~HostBrickCache();
+  HostBrickCache(const HostBrickCache&) = delete;
+  HostBrickCache& operator=(const HostBrickCache&) = delete;
 
   std::uint64_t capacity_bytes() const noexcept { return capacity_; }
   /// Accounted bytes of one brick: voxel bytes + kEntryOverhead.
   static std::uint64_t cost(const HostBrick& b) noexcept {
     return std::uint64_t(b.voxels.size()) + kEntryOverhead;
   }
+  /// The policy's name ("lru", "octreemizer").
+  std::string_view policy_name() const noexcept;
 
-  /// The brick, marked most recently used; nullptr when absent (counted as hit or miss).
+  /// The frame that later uses and insertions are recorded with (the renderer's frame).
+  void set_frame(std::uint64_t frame);
+
+  /// The brick, recorded as used; nullptr when absent (counted as hit or miss).
   std::shared_ptr<const HostBrick> get(BrickKey key);
   /// True when present; does not change the use order or the statistics.
   bool contains(BrickKey key) const;
-  /// Inserts or replaces a brick as most recently used, evicting least recently used entries
-  /// until the total fits.
+  /// Inserts or replaces a brick as used now, then evicts the policy's victims until the total
+  /// fits.
   void put(std::shared_ptr<const HostBrick> brick);
   void clear();
 
@@ -64,13 +78,26 @@ class HostBrickCache {
   HostBrickCacheStats stats() const;
 
  private:
-  using Order = std::list<std::shared_ptr<const HostBrick>>;  // front: most recently used
-  void evict_to_fit();                                        // caller holds mutex_
+  struct Entry {
+    std::shared_ptr<const HostBrick> brick;  // null: free slot
+    std::uint64_t last_frame = 0;            // for replaying the policy after growth
+    std::uint64_t last_seq = 0;
+  };
+  std::uint32_t take_slot();            // caller holds mutex_
+  void record_use(std::uint32_t slot);  // caller holds mutex_
+  void remove_slot(std::uint32_t slot);
+  void grow();
+  void evict_to_fit();
 
   std::uint64_t capacity_;
+  std::unique_ptr<EvictionPolicy> policy_;
   mutable std::mutex mutex_;
-  Order order_;
-  std::unordered_map<BrickKey, Order::iterator> index_;
+  std::vector<Entry> entries_;   // by policy slot
+  std::vector<CacheSlot> pins_;  // last_use = operation sequence: only the current op pins
+  std::vector<std::uint32_t> free_;
+  std::unordered_map<BrickKey, std::uint32_t> index_;
+  std::uint64_t frame_ = 0;
+  std::uint64_t seq_ = 0;
   std::uint64_t bytes_ = 0;
   HostBrickCacheStats stats_;
 };

@@ -14,7 +14,8 @@ namespace resoct {
 inline constexpr std::string_view kSourceSpecForms =
     "procedural:NAME[:WxHxD[:CHANNELS]], a resoct brick store (.rbs), an OME-Zarr directory, "
     "a NIfTI-1 file (.nii, .nii.gz), an NRRD file (.nrrd, .nhdr), a TIFF file or a directory of "
-    "TIFF files (.tif, .tiff), or stack:SPEC+SPEC+... (sources on one grid as channels)";
+    "TIFF files (.tif, .tiff), stack:SPEC+SPEC+... (sources on one grid as channels), or an "
+    "http(s):// URL of a brick store or an OME-Zarr image (URL[,PREFIX=URL]..., docs/http.md)";
 
 /// What a spec names, decided from its prefix, the file's magic bytes (brick store), the
 /// directory's content (OME-Zarr: a .zattrs or .zarray; TIFF: .tif/.tiff files) or the file
@@ -44,7 +45,11 @@ SourceKind detect_source_kind(std::string_view spec);
 /// - an OME-Zarr directory, a NIfTI, NRRD or TIFF file, or a directory of TIFF files gives the
 ///   format's source (include/resoct/formats/, docs/formats.md), bricked with `layout`;
 /// - `stack:A+B+...` opens every part with open_source and stacks their channels
-///   (formats/channel_stack.hpp).
+///   (formats/channel_stack.hpp);
+/// - an http:// or https:// URL (default HttpOptions, docs/http.md): an OME-Zarr image when the
+///   URL has a `.zattrs` or `.zarray` below it, read through an HttpStore (a URL map
+///   "URL,PREFIX=URL,..." routes key prefixes to other hosts and always means OME-Zarr), else a
+///   brick store read by Range requests (recognized by its magic bytes).
 /// Raw files need extent, type and byte order, so they are not accepted here: open them with
 /// open_raw_volume() and wrap the result in an InMemorySource (or convert them with
 /// resoct-convert).

@@ -9,6 +9,7 @@
 #include <limits>
 #include <algorithm>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -26,11 +27,23 @@
 #include "resoct/hierarchy.hpp"
 #include "resoct/octree_layout.hpp"
 #include "resoct/page_table.hpp"
+#include "resoct/prefetch.hpp"
 #include "resoct/request_set.hpp"
 #include "resoct/residency_octree.hpp"
 #include "resoct/scene.hpp"
 
 namespace resoct {
+
+/// Prefetching ahead of camera motion (paper 001; docs/renderer.md, "Prefetching"). Each frame
+/// the camera's next `lookahead_frames` poses are extrapolated linearly from its last two, and
+/// up to `max_bricks` / `max_bytes` (padded voxel bytes) bricks those views may need and that are
+/// neither on the device nor in the host cache are queued for loading into the host cache, below
+/// every real request.
+struct PrefetchOptions {
+  std::uint32_t lookahead_frames = 0;                 ///< 0 disables prefetching; at most 64
+  std::uint32_t max_bricks = 64;                      ///< per frame, > 0 when enabled
+  std::uint64_t max_bytes = std::uint64_t(64) << 20;  ///< per frame, > 0 when enabled
+};
 
 /// Construction parameters of a Renderer; validate() names the offending field.
 struct RendererOptions {
@@ -43,8 +56,11 @@ struct RendererOptions {
   std::uint64_t host_cache_bytes = std::uint64_t(1) << 30;
   UploadBudget upload_budget{256, std::numeric_limits<std::uint64_t>::max()};
   std::uint32_t ttl = 2;         ///< frames a fresh upload stays pinned (>= 1)
-  std::string eviction = "lru";  ///< "lru" or "octreemizer"
-  glm::uvec3 leaf_size{16};      ///< residency octree leaf, voxels per axis
+  std::string eviction = "lru";  ///< device cache: "lru" or "octreemizer"
+  /// Host cache (decoded bricks): "lru" or "octreemizer" (distance from the current camera).
+  std::string host_eviction = "lru";
+  PrefetchOptions prefetch;
+  glm::uvec3 leaf_size{16};  ///< residency octree leaf, voxels per axis
   RenderMode mode = RenderMode::residency;
   RequestStrategy strategy = RequestStrategy::greedy;
   /// Loader threads; 0 loads synchronously inside render_frame (deterministic).
@@ -74,6 +90,12 @@ struct ConvergeReport {
   FrameReport last;  ///< the last frame; its `failures` lists those of all frames rendered
   std::uint32_t frames = 0;
   bool converged = false;
+};
+
+/// A camera position read by loader threads (host cache Octreemizer distances).
+struct SharedEye {
+  std::mutex mutex;
+  glm::dvec3 eye{0.0};
 };
 
 /// Thread-safety: none; drive one Renderer from one thread. The loader threads it owns read the
@@ -126,6 +148,7 @@ class Renderer {
   void send_update(FrameStats& stats);
   void answer_nodes(FrameStats& stats);
   bool handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats);
+  void prefetch(const Scene& scene, FrameStats& stats);
   void report_failures(FrameReport& report);
 
   std::shared_ptr<const BrickSource> source_;
@@ -143,6 +166,9 @@ class Renderer {
 
   std::vector<std::uint32_t> channel_rank_;  // per dataset channel: load rank in this scene
   glm::dvec3 camera_{0.0};                   // eye in physical units (Octreemizer distances)
+  // The same for the host cache's policy, which runs on loader threads.
+  std::shared_ptr<SharedEye> host_camera_ = std::make_shared<SharedEye>();
+  CameraPredictor predictor_;
   std::uint64_t frame_ = 0;
   bool send_full_ = true;                     // next update carries full arrays
   std::vector<LoadedBrick> staged_;           // loaded, waiting for budget or a free slot

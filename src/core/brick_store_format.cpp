@@ -98,7 +98,7 @@ std::vector<std::byte> encode_header(const StoreHeader& h) {
   return b;
 }
 
-StoreHeader decode_header(const ReadFile& file) {
+StoreHeader decode_header(const RandomAccessFile& file) {
   const std::string& path = file.path();
   const std::uint64_t fsize = file.size();
   auto fail = [&](ErrorCode code, std::uint64_t at, const std::string& what) {

@@ -16,13 +16,15 @@ using detail::IndexEntry;
 using detail::StoreHeader;
 
 struct BrickStoreSource::Impl {
-  Impl(ReadFile f, const StoreHeader& h)
-      : file(std::move(f)),
+  Impl(std::unique_ptr<RandomAccessFile> f, const StoreHeader& h)
+      : file_ptr(std::move(f)),
+        file(*file_ptr),
         header(h),
         hierarchy(h.volume, h.layout),
         pyramid(h.volume.extent, h.metadata_block, h.volume.channels) {}
 
-  ReadFile file;
+  std::unique_ptr<RandomAccessFile> file_ptr;
+  const RandomAccessFile& file;  // a local file or an HTTP object (Range requests)
   StoreHeader header;
   BrickHierarchy hierarchy;
   std::vector<IndexEntry> index;  // channel-major, then BrickHierarchy::linear_index
@@ -150,10 +152,14 @@ void BrickStoreSource::Impl::compute_stats() {
   }
 }
 
-BrickStoreSource::BrickStoreSource(const std::string& path) {
+BrickStoreSource::BrickStoreSource(const std::string& path)
+    : BrickStoreSource(std::make_unique<ReadFile>(path)) {}
+
+BrickStoreSource::BrickStoreSource(std::unique_ptr<RandomAccessFile> file) {
+  if (!file) throw invalid_parameter("file", "must not be null");
+  const std::string path = file->path();
   try {
-    ReadFile file(path);
-    const StoreHeader h = detail::decode_header(file);
+    const StoreHeader h = detail::decode_header(*file);
     impl_ = std::make_unique<Impl>(std::move(file), h);
     impl_->load_index();
     impl_->load_metadata();

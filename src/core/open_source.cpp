@@ -18,6 +18,7 @@
 #include "resoct/formats/nrrd.hpp"
 #include "resoct/formats/ome_zarr.hpp"
 #include "resoct/formats/tiff_stack.hpp"
+#include "resoct/http_store.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/store/format.hpp"
 
@@ -32,9 +33,8 @@ std::string accepted() {
   return "; accepted: " + std::string(kSourceSpecForms);
 }
 
-bool has_store_magic(const std::string& path) {
+bool has_store_magic(const RandomAccessFile& file) {
   const auto& magic = detail::kStoreMagic;
-  const ReadFile file(path);
   if (file.size() < magic.size()) return false;
   std::array<std::byte, detail::kStoreMagic.size()> head{};
   file.read_at(0, head);
@@ -68,7 +68,7 @@ SourceKind kind_of_directory(const std::string& path) {
 }
 
 SourceKind kind_of_file(const std::string& path) {
-  if (has_store_magic(path)) return SourceKind::brick_store;
+  if (has_store_magic(ReadFile(path))) return SourceKind::brick_store;
   const std::string name = lower(std::filesystem::path(path).filename().string());
   if (ends_with(name, ".nii") || ends_with(name, ".nii.gz")) return SourceKind::nifti;
   if (ends_with(name, ".nrrd") || ends_with(name, ".nhdr")) return SourceKind::nrrd;
@@ -92,6 +92,28 @@ std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout
     name += parts[i]->name();
   }
   return stack_channels(std::move(parts), std::move(name));
+}
+
+/// An http(s) URL: an OME-Zarr image when a URL map is given or the URL has zarr metadata below
+/// it, else a brick store file read by Range requests.
+std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout& layout) {
+  if (spec.find_first_of("?#") != std::string::npos) {
+    throw invalid_parameter("spec",
+                            "URL '" + spec + "' has a query or fragment, which is unsupported");
+  }
+  std::shared_ptr<const HttpStore> store = open_http_store(spec);
+  if (spec.find(',') != std::string::npos || store->size(".zattrs") || store->size(".zarray")) {
+    return open_ome_zarr(store, layout);
+  }
+  // Range requests only: the store's index and metadata are read once, bricks on demand.
+  auto file = open_random_access_file(spec);
+  if (!has_store_magic(*file)) {
+    throw file_error(ErrorCode::invalid_argument, spec, 0,
+                     "neither an OME-Zarr image (no .zattrs/.zarray below the URL) nor a resoct "
+                     "brick store (no store magic)" +
+                         accepted());
+  }
+  return std::make_unique<BrickStoreSource>(std::move(file));
 }
 
 }  // namespace
@@ -127,6 +149,7 @@ std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayou
   if (spec.starts_with(kStackPrefix)) return open_stack(spec.substr(kStackPrefix.size()), layout);
   if (spec.empty()) throw invalid_parameter("spec", "empty source" + accepted());
   const std::string path(spec);
+  if (is_http_url(spec)) return open_url(path, layout);
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     const int err = errno;

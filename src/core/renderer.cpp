@@ -42,6 +42,23 @@ std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, const Brick
   throw invalid_parameter("eviction", "'" + name + "' is not one of lru, octreemizer");
 }
 
+std::unique_ptr<EvictionPolicy> make_host_policy(const std::string& name, const BrickHierarchy& h,
+                                                 std::shared_ptr<SharedEye> eye) {
+  if (name == "lru") return std::make_unique<LruPolicy>();
+  if (name == "octreemizer") {
+    return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
+                                               [&h, eye](BrickKey key) {
+                                                 glm::dvec3 e;
+                                                 {
+                                                   std::lock_guard lock(eye->mutex);
+                                                   e = eye->eye;
+                                                 }
+                                                 return brick_camera_distance(h, key, e);
+                                               });
+  }
+  throw invalid_parameter("host_eviction", "'" + name + "' is not one of lru, octreemizer");
+}
+
 bool page_unmapped(std::uint32_t entry) {
   return kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED;
 }
@@ -60,6 +77,16 @@ void RendererOptions::validate() const {
   if (ttl == 0) throw invalid_parameter("ttl", "must be >= 1");
   if (eviction != "lru" && eviction != "octreemizer") {
     throw invalid_parameter("eviction", "'" + eviction + "' is not one of lru, octreemizer");
+  }
+  if (host_eviction != "lru" && host_eviction != "octreemizer") {
+    throw invalid_parameter("host_eviction",
+                            "'" + host_eviction + "' is not one of lru, octreemizer");
+  }
+  if (prefetch.lookahead_frames > 64) {
+    throw invalid_parameter("prefetch.lookahead_frames", "must be at most 64");
+  }
+  if (prefetch.lookahead_frames > 0 && (prefetch.max_bricks == 0 || prefetch.max_bytes == 0)) {
+    throw invalid_parameter("prefetch", "max_bricks and max_bytes must be > 0 when enabled");
   }
   if (loader_threads > 1024) throw invalid_parameter("loader_threads", "must be at most 1024");
   if (brick_request_capacity == 0 || brick_request_capacity > (1u << 28)) {
@@ -89,8 +116,9 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
       [this](std::uint32_t slot, std::uint32_t level, glm::uvec3 brick) {
         return !page_unmapped(pages_.entry(PageAddress{slot, level, brick}));
       });
-  loader_ =
-      std::make_unique<BrickLoader>(source_, options_.loader_threads, options_.host_cache_bytes);
+  loader_ = std::make_unique<BrickLoader>(
+      source_, options_.loader_threads, options_.host_cache_bytes,
+      make_host_policy(options_.host_eviction, hierarchy_, host_camera_));
   backend_ = create_backend(options_.backend, options_.backend_options);
   config_.voxel_type = hierarchy_.volume().type;
   config_.padded_brick = hierarchy_.layout().padded_size();
@@ -336,6 +364,42 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
   return outstanding || !pending_nodes_.empty() || result.stats.requests_dropped != 0;
 }
 
+void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
+  predictor_.observe(scene.camera);
+  const PrefetchOptions& po = options_.prefetch;
+  if (po.lookahead_frames == 0) return;
+  const std::vector<Camera> poses = predictor_.predict(po.lookahead_frames);
+  const std::uint64_t brick_bytes =
+      hierarchy_.layout().padded_voxels() * voxel_size(hierarchy_.volume().type);
+  const std::size_t max =
+      std::size_t(std::min<std::uint64_t>(po.max_bricks, po.max_bytes / brick_bytes));
+  std::vector<BrickKey> keys;
+  std::unordered_set<BrickKey> seen;
+  // Only what would still have to be read: not on the device, not in the host cache, not failed.
+  const auto want = [&](BrickKey k) {
+    const auto addr = channels_.address_of(k);
+    if (!addr || !page_unmapped(pages_.entry(*addr))) return false;
+    if (loader_->has_failed(k) || loader_->host_cache().contains(k)) return false;
+    return seen.insert(k).second;
+  };
+  Scene predicted = scene;
+  for (const Camera& c : poses) {
+    if (keys.size() >= max) break;
+    predicted.camera = c;
+    try {
+      const std::vector<BrickKey> more =
+          view_bricks(hierarchy_, predicted, max - keys.size(), want);
+      keys.insert(keys.end(), more.begin(), more.end());
+    } catch (const Error&) {
+      break;  // the extrapolated camera degenerated (eye on target, up along the view)
+    }
+  }
+  // Replaces the previous frame's prefetches: the prediction moved on.
+  loader_->prefetch(keys);
+  if (loader_->thread_count() == 0) loader_->run_prefetch(keys.size());
+  stats.prefetch_queued = keys.size();
+}
+
 void Renderer::report_failures(FrameReport& report) {
   report.failures = loader_->take_failures();
   report.stats.new_failures = report.failures.size();
@@ -370,7 +434,10 @@ FrameReport Renderer::render_frame(const Scene& scene) {
     // Box space has its longest physical axis spanning [0, 1] (docs/scene.md).
     const glm::dvec3 phys = physical_size(hierarchy_.volume());
     camera_ = scene.camera.eye * std::max({phys.x, phys.y, phys.z});
+    std::lock_guard lock(host_camera_->mutex);
+    host_camera_->eye = camera_;
   }
+  loader_->host_cache().set_frame(frame_);
   FrameReport report;
   FrameStats& stats = report.stats;
   stats.frame_index = frame_;
@@ -401,6 +468,7 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   stats.working_set_bricks = used.size();
   stats.working_set_bytes = used.size() * cache_->slot_bytes();
   const bool outstanding = handle_requests(result_, epoch, stats);
+  prefetch(scene, stats);
   stats.ms_requests = ms_since(t);
   report_failures(report);
   stats.resident_bricks = cache_->resident_count();

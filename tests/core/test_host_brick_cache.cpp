@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <thread>
 
@@ -101,4 +102,76 @@ TEST(HostBrickCache, ConcurrentUseKeepsTheByteBound) {
 }
 
 }  // namespace
+TEST(HostBrickCache, LruOrderSurvivesGrowthOfThePolicy) {
+  // 600 entries outgrow the initial policy size (256 slots) twice; a reference LRU list decides
+  // which keys must remain after random touches and insertions.
+  constexpr std::uint32_t kKeep = 500;
+  HostBrickCache c(kKeep * kCost);
+  std::mt19937 rng(11);
+  std::vector<std::uint32_t> order;  // reference: front = least recently used
+  auto use = [&](std::uint32_t x) {
+    order.erase(std::remove(order.begin(), order.end(), x), order.end());
+    order.push_back(x);
+    if (order.size() > kKeep) order.erase(order.begin());
+  };
+  for (std::uint32_t x = 0; x < 900; ++x) {
+    c.put(brick(x, 100));
+    use(x);
+    if (x > 10 && rng() % 3 == 0) {
+      const std::uint32_t y = order[rng() % order.size()];
+      ASSERT_NE(c.get(key(y)), nullptr) << y;
+      use(y);
+    }
+  }
+  EXPECT_EQ(c.size(), kKeep);
+  for (std::uint32_t x : order) EXPECT_TRUE(c.contains(key(x))) << x;
+  EXPECT_EQ(c.bytes(), kKeep * kCost);
+}
+
+TEST(HostBrickCache, OctreemizerEvictsTheLargestDiscardPriority) {
+  // Levels 0..3, distance = x; weights as in the paper. Brute force: the evicted entry is the
+  // one with the largest p = ka * age + kl * depth + kd * distance among the others.
+  const OctreemizerWeights w{1.0, 16.0, 1.0};
+  const std::uint32_t levels = 4;
+  auto policy = std::make_unique<OctreemizerPolicy>(levels, w,
+                                                    [](BrickKey k) { return double(k.brick().x); });
+  HostBrickCache c(6 * kCost, std::move(policy));
+  EXPECT_EQ(c.policy_name(), "octreemizer");
+  std::mt19937 rng(5);
+  struct Ref {
+    BrickKey key;
+    std::uint64_t last_use;
+  };
+  std::vector<Ref> ref;
+  for (std::uint64_t frame = 1; frame <= 40; ++frame) {
+    c.set_frame(frame);
+    auto b = std::make_shared<HostBrick>();
+    b->key = BrickKey(rng() % levels, 0, glm::uvec3(std::uint32_t(frame) * 7 % 50, 0, 0));
+    b->voxels.assign(100, std::byte{1});
+    if (c.contains(b->key)) continue;
+    if (ref.size() == 6) {
+      std::size_t worst = 0;
+      double worst_p = -1.0;
+      for (std::size_t i = 0; i < ref.size(); ++i) {
+        const double p = w.ka * double(frame - ref[i].last_use) +
+                         w.kl * double(levels - 1 - ref[i].key.level()) +
+                         w.kd * double(ref[i].key.brick().x);
+        if (p > worst_p) worst_p = p, worst = i;
+      }
+      c.put(b);
+      EXPECT_FALSE(c.contains(ref[worst].key)) << "frame " << frame;
+      ref.erase(ref.begin() + std::ptrdiff_t(worst));
+    } else {
+      c.put(b);
+    }
+    ref.push_back({b->key, frame});
+    // Touch one older entry now and then: it becomes young again.
+    if (frame % 4 == 0 && ref.size() > 1) {
+      ASSERT_NE(c.get(ref.front().key), nullptr);
+      ref.front().last_use = frame;
+    }
+    for (const Ref& r : ref) EXPECT_TRUE(c.contains(r.key));
+  }
+}
+
 }  // namespace resoct

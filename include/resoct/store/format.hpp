@@ -110,7 +110,7 @@ std::vector<std::byte> encode_header(const StoreHeader& h);
 /// Reads and validates the header of `file` (magic, size, CRC, version, every field, section
 /// bounds against the file size, agreement with the hierarchy the fields describe). Throws
 /// resoct::Error with the code of the first problem found and the offending byte offset.
-StoreHeader decode_header(const ReadFile& file);
+StoreHeader decode_header(const RandomAccessFile& file);
 
 void encode_index_entry(const IndexEntry& e, std::span<std::byte, kIndexEntrySize> out);
 IndexEntry decode_index_entry(std::span<const std::byte, kIndexEntrySize> in);

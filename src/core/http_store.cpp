@@ -1,0 +1,582 @@
+#include "resoct/http_store.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cstring>
+#include <mutex>
+#include <thread>
+
+#include <curl/curl.h>
+
+#include "resoct/error.hpp"
+
+namespace resoct {
+
+namespace {
+
+bool starts_with_ci(std::string_view s, std::string_view prefix) {
+  if (s.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(s[i])) != prefix[i]) return false;
+  }
+  return true;
+}
+
+void check_url(std::string_view url) {
+  const std::size_t scheme = starts_with_ci(url, "http://") ? 7 : 8;
+  if (!is_http_url(url) || url.size() <= scheme || url[scheme] == '/') {
+    throw invalid_parameter("url_map", "'" + std::string(url) + "' is not an http(s)://host URL");
+  }
+  for (char c : url) {
+    if (static_cast<unsigned char>(c) <= 0x20 || c == 0x7F) {
+      throw invalid_parameter("url_map",
+                              "'" + std::string(url) + "' contains a space or control character");
+    }
+  }
+}
+
+std::string trim_slashes(std::string_view url) {
+  while (!url.empty() && url.back() == '/') url.remove_suffix(1);
+  return std::string(url);
+}
+
+bool prefix_matches(std::string_view prefix, std::string_view key) {
+  return key.starts_with(prefix) && (key.size() == prefix.size() || key[prefix.size()] == '/');
+}
+
+std::string percent_encode(std::string_view key) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  out.reserve(key.size());
+  for (char ch : key) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (std::isalnum(c) || c == '.' || c == '_' || c == '~' || c == '-' || c == '/') {
+      out.push_back(ch);
+    } else {
+      out.push_back('%');
+      out.push_back(kHex[c >> 4]);
+      out.push_back(kHex[c & 15]);
+    }
+  }
+  return out;
+}
+
+std::optional<std::uint64_t> parse_u64(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  std::uint64_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+void global_init() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (curl_global_init(CURL_GLOBAL_DEFAULT) != CURLE_OK) {
+      throw Error(ErrorCode::io, "libcurl: curl_global_init failed");
+    }
+  });
+}
+
+/// State of one attempt, shared with libcurl's callbacks.
+struct Attempt {
+  // What the caller wants.
+  bool ranged = false;
+  std::uint64_t offset = 0;                 // ranged: first byte wanted
+  std::uint64_t want = 0;                   // ranged: bytes wanted
+  std::uint64_t max_bytes = 0;              // whole object: limit
+  std::span<std::byte> out;                 // ranged: destination
+  std::vector<std::byte>* whole = nullptr;  // whole object: destination
+  // What arrived.
+  long status = 0;
+  std::optional<std::uint64_t> content_length;
+  std::string content_range;
+  std::uint64_t received = 0;  // body bytes of the final response
+  std::uint64_t kept = 0;
+  bool too_large = false;
+  bool complete_early = false;  // a 200 answer to a range request: stopped once `want` arrived
+  std::string bad_answer;       // set when the server's answer contradicts the request
+
+  bool ok_status() const { return status >= 200 && status < 300; }
+};
+
+std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
+  auto& a = *static_cast<Attempt*>(user);
+  const std::size_t len = size * n;
+  std::string_view line(data, len);
+  if (line.starts_with("HTTP/")) {
+    // A new response (after a redirect or "100 Continue"): forget the previous headers.
+    a.content_length.reset();
+    a.content_range.clear();
+    const std::size_t sp = line.find(' ');
+    a.status = 0;
+    if (sp != std::string_view::npos) {
+      std::from_chars(line.data() + sp + 1, line.data() + std::min(len, sp + 4), a.status);
+    }
+    return len;
+  }
+  const std::size_t colon = line.find(':');
+  if (colon == std::string_view::npos) return len;
+  std::string name(line.substr(0, colon));
+  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const std::string_view value = line.substr(colon + 1);
+  if (name == "content-length") {
+    a.content_length = parse_u64(value);
+    // Refuse an oversized object before its first byte arrives.
+    if (!a.ranged && a.ok_status() && a.content_length && *a.content_length > a.max_bytes) {
+      a.too_large = true;
+      return 0;
+    }
+  } else if (name == "content-range") {
+    std::string_view v = value;
+    while (!v.empty() && v.front() == ' ') v.remove_prefix(1);
+    while (!v.empty() && std::isspace(static_cast<unsigned char>(v.back()))) v.remove_suffix(1);
+    a.content_range = std::string(v);
+  }
+  return len;
+}
+
+std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
+  auto& a = *static_cast<Attempt*>(user);
+  const std::size_t len = size * n;
+  const auto* bytes = reinterpret_cast<const std::byte*>(data);
+  const std::uint64_t at = a.received;
+  a.received += len;
+  if (!a.ok_status()) return len;  // an error page; only the status matters
+  if (!a.ranged) {
+    if (a.received > a.max_bytes) {
+      a.too_large = true;
+      return 0;
+    }
+    a.whole->insert(a.whole->end(), bytes, bytes + len);
+    a.kept = a.received;
+    return len;
+  }
+  if (a.status == 206) {
+    if (a.received > a.want) {
+      a.bad_answer = "206 answer longer than the " + std::to_string(a.want) + " bytes requested";
+      return 0;
+    }
+    std::memcpy(a.out.data() + at, bytes, len);
+    a.kept = a.received;
+    return len;
+  }
+  // 200 to a range request: the whole object streams in; keep only [offset, offset + want).
+  const std::uint64_t lo = std::max(at, a.offset);
+  const std::uint64_t hi = std::min<std::uint64_t>(a.received, a.offset + a.want);
+  if (lo < hi) {
+    std::memcpy(a.out.data() + (lo - a.offset), bytes + (lo - at), std::size_t(hi - lo));
+    a.kept += hi - lo;
+  }
+  if (a.kept == a.want) {
+    a.complete_early = true;
+    return 0;  // abort: the rest of the object is not needed
+  }
+  return len;
+}
+
+bool transient(CURLcode c) {
+  switch (c) {
+    case CURLE_OPERATION_TIMEDOUT:
+    case CURLE_COULDNT_CONNECT:
+    case CURLE_RECV_ERROR:
+    case CURLE_SEND_ERROR:
+    case CURLE_GOT_NOTHING:
+    case CURLE_PARTIAL_FILE:
+    case CURLE_HTTP2:
+    case CURLE_HTTP2_STREAM:
+    case CURLE_SSL_CONNECT_ERROR: return true;
+    default: return false;
+  }
+}
+
+enum class Outcome { done, absent, retry, fail };
+
+}  // namespace
+
+bool is_http_url(std::string_view s) noexcept {
+  return starts_with_ci(s, "http://") || starts_with_ci(s, "https://");
+}
+
+UrlMap parse_url_map(std::string_view spec) {
+  UrlMap map;
+  bool have_base = false;
+  std::size_t start = 0;
+  while (start <= spec.size()) {
+    std::size_t end = spec.find(',', start);
+    if (end == std::string_view::npos) end = spec.size();
+    const std::string_view entry = spec.substr(start, end - start);
+    start = end + 1;
+    if (entry.empty())
+      throw invalid_parameter("url_map", "empty entry in '" + std::string(spec) + "'");
+    if (is_http_url(entry)) {
+      if (have_base) {
+        throw invalid_parameter("url_map", "more than one base URL in '" + std::string(spec) + "'");
+      }
+      check_url(entry);
+      map.base = trim_slashes(entry);
+      have_base = true;
+      continue;
+    }
+    const std::size_t eq = entry.find('=');
+    if (eq == std::string_view::npos) {
+      throw invalid_parameter("url_map",
+                              "entry '" + std::string(entry) + "' is neither a URL nor PREFIX=URL");
+    }
+    const std::string_view prefix = entry.substr(0, eq);
+    const std::string_view url = entry.substr(eq + 1);
+    try {
+      check_store_key(prefix);
+    } catch (const Error&) {
+      throw invalid_parameter(
+          "url_map", "route prefix '" + std::string(prefix) + "' is not a valid store key");
+    }
+    check_url(url);
+    for (const auto& [p, u] : map.routes) {
+      if (p == prefix) {
+        throw invalid_parameter("url_map", "route prefix '" + std::string(prefix) + "' repeated");
+      }
+    }
+    map.routes.emplace_back(std::string(prefix), trim_slashes(url));
+  }
+  if (!have_base) throw invalid_parameter("url_map", "no base URL in '" + std::string(spec) + "'");
+  return map;
+}
+
+void HttpOptions::validate() const {
+  if (connect_timeout_ms == 0) throw invalid_parameter("connect_timeout_ms", "must be > 0");
+  if (total_timeout_ms == 0) throw invalid_parameter("total_timeout_ms", "must be > 0");
+  if (low_speed_bytes != 0 && low_speed_time_s == 0) {
+    throw invalid_parameter("low_speed_time_s", "must be > 0 when low_speed_bytes is set");
+  }
+  if (retries > 20) throw invalid_parameter("retries", "must be at most 20");
+  if (backoff_max_ms < backoff_initial_ms) {
+    throw invalid_parameter("backoff_max_ms", "must be >= backoff_initial_ms");
+  }
+  if (max_idle_connections == 0 || max_idle_connections > 1024) {
+    throw invalid_parameter("max_idle_connections", "must be 1..1024");
+  }
+}
+
+struct HttpStore::Impl {
+  UrlMap map;
+  HttpOptions options;
+  CURLSH* share = nullptr;
+  std::array<std::mutex, CURL_LOCK_DATA_LAST> share_locks;
+  std::mutex pool_mutex;
+  std::vector<CURL*> pool;  // idle easy handles; each keeps its own keep-alive connections
+  std::atomic<std::uint64_t> requests{0}, retries{0}, connections{0}, bytes{0};
+
+  ~Impl() {
+    for (CURL* h : pool) curl_easy_cleanup(h);
+    if (share) curl_share_cleanup(share);
+  }
+
+  CURL* acquire() {
+    {
+      std::lock_guard lock(pool_mutex);
+      if (!pool.empty()) {
+        CURL* h = pool.back();  // LIFO: the most recently used handle has a live connection
+        pool.pop_back();
+        return h;
+      }
+    }
+    CURL* h = curl_easy_init();
+    if (!h) throw Error(ErrorCode::out_of_memory, "libcurl: curl_easy_init failed");
+    return h;
+  }
+
+  void release(CURL* h) {
+    std::lock_guard lock(pool_mutex);
+    if (pool.size() < options.max_idle_connections) {
+      pool.push_back(h);
+    } else {
+      curl_easy_cleanup(h);
+    }
+  }
+
+  std::string url_of(std::string_view key) const {
+    const std::string* best = &map.base;
+    std::size_t best_len = 0;
+    for (const auto& [prefix, url] : map.routes) {
+      if (prefix.size() > best_len && prefix_matches(prefix, key)) {
+        best = &url;
+        best_len = prefix.size();
+      }
+    }
+    return *best + "/" + percent_encode(key);
+  }
+
+  /// One attempt; fills `why` for failures.
+  Outcome attempt(CURL* h, const std::string& url, bool head, Attempt& a, ErrorCode& code,
+                  std::string& why) {
+    curl_easy_reset(h);  // keeps the handle's connections, drops the previous request's options
+    curl_easy_setopt(h, CURLOPT_URL, url.c_str());
+    curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
+    curl_easy_setopt(h, CURLOPT_SHARE, share);
+    curl_easy_setopt(h, CURLOPT_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 1L);
+    curl_easy_setopt(h, CURLOPT_MAXREDIRS, 5L);
+    curl_easy_setopt(h, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
+    curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT_MS, long(options.connect_timeout_ms));
+    curl_easy_setopt(h, CURLOPT_TIMEOUT_MS, long(options.total_timeout_ms));
+    if (options.low_speed_bytes != 0) {
+      curl_easy_setopt(h, CURLOPT_LOW_SPEED_LIMIT, long(options.low_speed_bytes));
+      curl_easy_setopt(h, CURLOPT_LOW_SPEED_TIME, long(options.low_speed_time_s));
+    }
+    curl_easy_setopt(h, CURLOPT_MAXCONNECTS, long(options.max_idle_connections));
+    curl_easy_setopt(h, CURLOPT_TCP_KEEPALIVE, 1L);
+    curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, on_header);
+    curl_easy_setopt(h, CURLOPT_HEADERDATA, &a);
+    curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, on_body);
+    curl_easy_setopt(h, CURLOPT_WRITEDATA, &a);
+    if (head) curl_easy_setopt(h, CURLOPT_NOBODY, 1L);
+    std::string range;
+    if (a.ranged) {
+      range = std::to_string(a.offset) + "-" + std::to_string(a.offset + a.want - 1);
+      curl_easy_setopt(h, CURLOPT_RANGE, range.c_str());
+    }
+    char curl_error[CURL_ERROR_SIZE] = {};
+    curl_easy_setopt(h, CURLOPT_ERRORBUFFER, curl_error);
+
+    const CURLcode rc = curl_easy_perform(h);
+    ++requests;
+    long connects = 0;
+    if (curl_easy_getinfo(h, CURLINFO_NUM_CONNECTS, &connects) == CURLE_OK && connects > 0) {
+      connections += std::uint64_t(connects);
+    }
+    long status = 0;
+    curl_easy_getinfo(h, CURLINFO_RESPONSE_CODE, &status);
+    if (status != 0) a.status = status;
+
+    if (a.too_large) {
+      code = ErrorCode::out_of_range;
+      why = "object exceeds the limit of " + std::to_string(a.max_bytes) + " bytes";
+      return Outcome::fail;
+    }
+    if (!a.bad_answer.empty()) {
+      code = ErrorCode::io;
+      why = a.bad_answer;
+      return Outcome::fail;
+    }
+    if (a.complete_early) return Outcome::done;
+    if (rc != CURLE_OK) {
+      const char* text = curl_error[0] ? curl_error : curl_easy_strerror(rc);
+      code = rc == CURLE_PARTIAL_FILE ? ErrorCode::truncated : ErrorCode::io;
+      why = std::string(rc == CURLE_PARTIAL_FILE ? "truncated body: " : "") + text;
+      return transient(rc) ? Outcome::retry : Outcome::fail;
+    }
+    if (a.status == 404 || a.status == 410) {
+      code = ErrorCode::io;
+      why = "not found (HTTP " + std::to_string(a.status) + ")";
+      return Outcome::absent;
+    }
+    if (a.status == 416) {
+      code = ErrorCode::truncated;
+      why = "range of " + std::to_string(a.want) + " bytes starts past the end (HTTP 416)";
+      return Outcome::fail;
+    }
+    if (a.status == 408 || a.status == 429 || (a.status >= 500 && a.status < 600)) {
+      code = ErrorCode::io;
+      why = "HTTP " + std::to_string(a.status);
+      return Outcome::retry;
+    }
+    if (!a.ok_status()) {
+      code = ErrorCode::io;
+      why = "HTTP " + std::to_string(a.status);
+      return Outcome::fail;
+    }
+    if (!head && a.content_length && *a.content_length != a.received) {
+      code = ErrorCode::truncated;
+      why = "truncated body: " + std::to_string(a.received) + " of " +
+            std::to_string(*a.content_length) + " announced bytes";
+      return Outcome::retry;
+    }
+    if (a.ranged) return check_range(a, code, why);
+    return Outcome::done;
+  }
+
+  static Outcome check_range(const Attempt& a, ErrorCode& code, std::string& why) {
+    if (a.status == 206) {
+      // "bytes FIRST-LAST/TOTAL" (TOTAL may be '*').
+      std::string_view cr = a.content_range;
+      std::optional<std::uint64_t> first, last;
+      if (cr.starts_with("bytes ")) {
+        cr.remove_prefix(6);
+        const std::size_t dash = cr.find('-'), slash = cr.find('/');
+        if (dash != std::string_view::npos && slash != std::string_view::npos && dash < slash) {
+          first = parse_u64(cr.substr(0, dash));
+          last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
+        }
+      }
+      if (!first || !last || *first != a.offset || *last < *first ||
+          *last > a.offset + a.want - 1) {
+        code = ErrorCode::io;
+        why = "206 answer with Content-Range '" + a.content_range + "' for bytes " +
+              std::to_string(a.offset) + "-" + std::to_string(a.offset + a.want - 1);
+        return Outcome::fail;
+      }
+      if (*last - *first + 1 != a.received || a.received < a.want) {
+        code = ErrorCode::truncated;
+        why = "object ends after " + std::to_string(a.received) + " of " + std::to_string(a.want) +
+              " requested bytes";
+        return Outcome::fail;
+      }
+      return Outcome::done;
+    }
+    // A complete 200 body that never reached offset + want: the object is shorter.
+    code = ErrorCode::truncated;
+    why = "object of " + std::to_string(a.received) + " bytes ends before the range of " +
+          std::to_string(a.want) + " bytes";
+    return Outcome::fail;
+  }
+
+  /// Runs attempts with backoff. Returns false for absence; throws for failures.
+  bool run(std::string_view key, bool head, Attempt& proto, std::vector<std::byte>* whole) {
+    const std::string url = url_of(key);
+    CURL* h = acquire();
+    struct Release {
+      Impl* self;
+      CURL* h;
+      ~Release() { self->release(h); }
+    } release_guard{this, h};
+    std::uint32_t delay = options.backoff_initial_ms;
+    for (std::uint32_t attempt_no = 0;; ++attempt_no) {
+      Attempt a = proto;
+      if (whole) whole->clear();
+      ErrorCode code = ErrorCode::io;
+      std::string why;
+      const Outcome o = attempt(h, url, head, a, code, why);
+      if (o == Outcome::done) {
+        bytes += a.kept;
+        proto = a;
+        return true;
+      }
+      if (o == Outcome::absent) return false;
+      if (o == Outcome::retry && attempt_no < options.retries) {
+        ++retries;
+        std::this_thread::sleep_for(std::chrono::milliseconds(delay));
+        delay = std::min(options.backoff_max_ms, delay * 2);
+        continue;
+      }
+      const std::string attempts =
+          " (" + std::to_string(attempt_no + 1) + (attempt_no == 0 ? " attempt)" : " attempts)");
+      if (proto.ranged) throw file_error(code, url, proto.offset, why + attempts);
+      throw Error(code, url + ": " + why + attempts);
+    }
+  }
+};
+
+HttpStore::HttpStore(UrlMap map, HttpOptions options) : impl_(std::make_unique<Impl>()) {
+  options.validate();
+  check_url(map.base);
+  map.base = trim_slashes(map.base);
+  for (auto& [prefix, url] : map.routes) {
+    check_store_key(prefix);
+    check_url(url);
+    url = trim_slashes(url);
+  }
+  global_init();
+  impl_->map = std::move(map);
+  impl_->options = options;
+  impl_->share = curl_share_init();
+  if (!impl_->share) throw Error(ErrorCode::out_of_memory, "libcurl: curl_share_init failed");
+  // Connections are not shared between handles: libcurl does not support a shared connection
+  // cache used by concurrent threads. Each pooled handle keeps its own keep-alive connections;
+  // DNS answers and TLS sessions are shared.
+  curl_share_setopt(
+      impl_->share, CURLSHOPT_LOCKFUNC,
+      +[](CURL*, curl_lock_data data, curl_lock_access, void* user) {
+        static_cast<Impl*>(user)->share_locks[std::size_t(data)].lock();
+      });
+  curl_share_setopt(
+      impl_->share, CURLSHOPT_UNLOCKFUNC, +[](CURL*, curl_lock_data data, void* user) {
+        static_cast<Impl*>(user)->share_locks[std::size_t(data)].unlock();
+      });
+  curl_share_setopt(impl_->share, CURLSHOPT_USERDATA, impl_.get());
+  curl_share_setopt(impl_->share, CURLSHOPT_SHARE, CURL_LOCK_DATA_DNS);
+  curl_share_setopt(impl_->share, CURLSHOPT_SHARE, CURL_LOCK_DATA_SSL_SESSION);
+}
+
+HttpStore::~HttpStore() = default;
+
+std::optional<std::vector<std::byte>> HttpStore::get(std::string_view key,
+                                                     std::uint64_t max_bytes) const {
+  check_store_key(key);
+  std::vector<std::byte> body;
+  Attempt a;
+  a.max_bytes = max_bytes;
+  a.whole = &body;
+  if (!impl_->run(key, false, a, &body)) return std::nullopt;
+  return body;
+}
+
+void HttpStore::read_range(std::string_view key, std::uint64_t offset,
+                           std::span<std::byte> out) const {
+  check_store_key(key);
+  if (out.empty()) return;
+  if (offset > std::numeric_limits<std::uint64_t>::max() - out.size()) {
+    throw invalid_parameter("offset", "offset + size overflows");
+  }
+  Attempt a;
+  a.ranged = true;
+  a.offset = offset;
+  a.want = out.size();
+  a.out = out;
+  if (!impl_->run(key, false, a, nullptr)) {
+    throw file_error(ErrorCode::io, location(key), offset, "not found (HTTP 404)");
+  }
+}
+
+std::vector<std::byte> HttpStore::get_range(std::string_view key, std::uint64_t offset,
+                                            std::uint64_t size) const {
+  check_store_key(key);
+  // Allocation follows the caller's request, as for a local file after its size check; the
+  // caller bounds `size` (brick store index entries are validated first).
+  std::vector<std::byte> out(static_cast<std::size_t>(size));
+  read_range(key, offset, out);
+  return out;
+}
+
+std::optional<std::uint64_t> HttpStore::size(std::string_view key) const {
+  check_store_key(key);
+  Attempt a;
+  a.max_bytes = std::numeric_limits<std::uint64_t>::max();
+  if (!impl_->run(key, true, a, nullptr)) return std::nullopt;
+  if (!a.content_length) {
+    throw Error(ErrorCode::io, location(key) + ": HEAD answer without Content-Length");
+  }
+  return *a.content_length;
+}
+
+std::string HttpStore::location(std::string_view key) const {
+  return impl_->url_of(key);
+}
+
+const UrlMap& HttpStore::url_map() const noexcept {
+  return impl_->map;
+}
+
+const HttpOptions& HttpStore::options() const noexcept {
+  return impl_->options;
+}
+
+HttpStats HttpStore::stats() const {
+  HttpStats s;
+  s.requests = impl_->requests.load();
+  s.retries = impl_->retries.load();
+  s.connections = impl_->connections.load();
+  s.bytes = impl_->bytes.load();
+  return s;
+}
+
+std::shared_ptr<HttpStore> open_http_store(std::string_view url_map_spec, HttpOptions options) {
+  return std::make_shared<HttpStore>(parse_url_map(url_map_spec), options);
+}
+
+}  // namespace resoct

@@ -1,0 +1,91 @@
+#include "resoct/random_access_file.hpp"
+
+#include <cctype>
+#include <limits>
+#include <optional>
+
+#include "resoct/error.hpp"
+#include "resoct/file_io.hpp"
+#include "resoct/http_store.hpp"
+
+namespace resoct {
+
+namespace {
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+std::string percent_decode(std::string_view s, const std::string& url) {
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] != '%') {
+      out.push_back(s[i]);
+      continue;
+    }
+    const int hi = i + 2 < s.size() ? hex_value(s[i + 1]) : -1;
+    const int lo = i + 2 < s.size() ? hex_value(s[i + 2]) : -1;
+    if (hi < 0 || lo < 0) throw invalid_parameter("url", "bad percent-escape in '" + url + "'");
+    out.push_back(char(hi * 16 + lo));
+    i += 2;
+  }
+  return out;
+}
+
+/// An object on an HTTP server read by Range requests.
+class HttpFile final : public RandomAccessFile {
+ public:
+  HttpFile(const std::string& url, const HttpOptions& options) : url_(url) {
+    if (url.find_first_of("?#") != std::string::npos) {
+      throw invalid_parameter("url", "'" + url + "' has a query or fragment, which is unsupported");
+    }
+    const std::size_t scheme_end = url.find("://") + 3;
+    const std::size_t slash = url.find_last_of('/');
+    if (slash == std::string::npos || slash < scheme_end || slash + 1 == url.size()) {
+      throw invalid_parameter("url", "'" + url + "' does not name a file on a server");
+    }
+    key_ = percent_decode(std::string_view(url).substr(slash + 1), url);
+    check_store_key(key_);
+    store_ = std::make_shared<HttpStore>(UrlMap{url.substr(0, slash), {}}, options);
+    const std::optional<std::uint64_t> size = store_->size(key_);
+    if (!size) throw file_error(ErrorCode::io, url_, 0, "not found (HTTP 404)");
+    size_ = *size;
+  }
+
+  const std::string& path() const noexcept override { return url_; }
+  std::uint64_t size() const noexcept override { return size_; }
+
+  void read_at(std::uint64_t offset, std::span<std::byte> out) const override {
+    // Checked here like a local file: a request past the end is the file's truncation, not the
+    // server's business.
+    if (offset > size_ || out.size() > size_ - offset) {
+      throw file_error(ErrorCode::truncated, url_, offset,
+                       "read of " + std::to_string(out.size()) + " bytes runs past the end (" +
+                           std::to_string(size_) + " bytes)");
+    }
+    store_->read_range(key_, offset, out);
+  }
+
+ private:
+  std::string url_;
+  std::string key_;
+  std::shared_ptr<HttpStore> store_;
+  std::uint64_t size_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url,
+                                                          const HttpOptions& http) {
+  if (is_http_url(path_or_url)) return std::make_unique<HttpFile>(path_or_url, http);
+  return std::make_unique<ReadFile>(path_or_url);
+}
+
+std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url) {
+  return open_random_access_file(path_or_url, HttpOptions{});
+}
+
+}  // namespace resoct

@@ -1,0 +1,69 @@
+// OME-Zarr over HTTP: open_source of a URL reads the same bricks as the local directory (stored
+// and computed levels, missing chunks as fill value), and a URL map spreads a level over a
+// second server.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "resoct/formats/ome_zarr.hpp"
+#include "resoct/http_store.hpp"
+#include "resoct/open_source.hpp"
+#include "support/brick_compare.hpp"
+#include "support/expect_error.hpp"
+#include "support/generated_data.hpp"
+#include "support/http_test_server.hpp"
+
+using namespace resoct;
+using resoct::test::HttpTestServer;
+
+namespace {
+
+const std::string& data_dir() {
+  static const std::string dir = test::python_generated_dir(
+      RESOCT_BINARY_DIR "/test-data", "ome-zarr", RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr.py");
+  return dir;
+}
+
+int server_requests(const HttpTestServer& s) {
+  HttpStore stats(parse_url_map("http://127.0.0.1:" + std::to_string(s.port())));
+  const auto b = stats.get("_stats", 1 << 16);
+  return nlohmann::json::parse(
+             std::string(reinterpret_cast<const char*>(b->data()), b->size()))["requests"]
+      .get<int>();
+}
+
+}  // namespace
+
+TEST(HttpOmeZarr, UrlReadsTheSameBricksAsTheDirectory) {
+  ASSERT_FALSE(data_dir().empty());
+  HttpTestServer server(HttpTestServer::default_script(), data_dir());
+  const BrickLayout layout{glm::uvec3(8), 1};
+  for (const char* name : {"pyramid_u2", "fill_u1"}) {
+    const auto local = open_ome_zarr(data_dir() + "/" + name + ".zarr", layout);
+    const std::string url = server.base("ok") + "/" + name + ".zarr";
+    const auto remote = open_source(url, layout);
+    test::expect_same_bricks(*local, *remote);
+  }
+}
+
+TEST(HttpOmeZarr, UrlMapSendsALevelToASecondServer) {
+  ASSERT_FALSE(data_dir().empty());
+  HttpTestServer a(HttpTestServer::default_script(), data_dir());
+  HttpTestServer b(HttpTestServer::default_script(), data_dir());  // a mirror
+  const BrickLayout layout{glm::uvec3(8), 1};
+  const std::string spec = a.base("ok") + "/pyramid_u2.zarr,1=" + b.base("ok") + "/pyramid_u2.zarr";
+  const auto remote = open_source(spec, layout);
+  const auto local = open_ome_zarr(data_dir() + "/pyramid_u2.zarr", layout);
+  test::expect_same_bricks(*local, *remote);
+  // Both hosts served requests (the stats requests themselves are not counted yet).
+  EXPECT_GT(server_requests(a), 0);
+  EXPECT_GT(server_requests(b), 0);
+}
+
+TEST(HttpOmeZarr, AUrlThatIsNeitherZarrNorStoreNamesTheUrl) {
+  ASSERT_FALSE(data_dir().empty());
+  HttpTestServer server(HttpTestServer::default_script(), data_dir());
+  const std::string url = server.base("ok") + "/manifest.json";
+  EXPECT_RESOCT_ERROR(open_source(url), ErrorCode::invalid_argument, url);
+}

@@ -1,0 +1,155 @@
+#!/usr/bin/python3
+"""Loopback HTTP/1.1 file server for resoct's HTTP tests and benchmarks.
+
+Usage: http_test_server.py ROOT
+Serves the files below ROOT on 127.0.0.1 at a free port (bound as port 0) and prints
+"PORT <n>" as its first line. Exits when its standard input reaches EOF, so it cannot outlive
+the test process that started it.
+
+The first path component selects a behaviour, the rest names the file below ROOT:
+  /ok/F        GET and HEAD with Range support (206 + Content-Range, 416 past the end)
+  /norange/F   ignores Range headers (always 200 with the whole file)
+  /missing/F   404
+  /flaky/F     500 for the first two requests of each path, then like /ok
+  /fail/F      always 500
+  /truncate/F  announces the full Content-Length, sends half the body, closes the connection
+  /stall/F     accepts the request and sends nothing for 60 s
+  /_stats      JSON {"connections": n, "requests": n} since start or the last /_reset
+  /_reset      zeroes the counters and the /flaky attempt counts
+"""
+import http.server
+import json
+import os
+import re
+import socket
+import sys
+import threading
+import time
+
+ROOT = os.path.realpath(sys.argv[1])
+LOCK = threading.Lock()
+STATS = {"connections": 0, "requests": 0}
+FLAKY = {}
+
+
+class Handler(http.server.BaseHTTPRequestHandler):
+    protocol_version = "HTTP/1.1"
+
+    def setup(self):
+        super().setup()
+        # Headers and body go out in separate writes; without this, Nagle's algorithm and the
+        # client's delayed ACK add 40 ms to every response.
+        self.connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        with LOCK:
+            STATS["connections"] += 1
+
+    def log_message(self, *args):
+        pass
+
+    def send_bytes(self, code, body, extra=(), send_body=True):
+        self.send_response(code)
+        self.send_header("Content-Length", str(len(body)))
+        for k, v in extra:
+            self.send_header(k, v)
+        self.end_headers()
+        if send_body:
+            self.wfile.write(body)
+
+    def do_HEAD(self):
+        self.handle_request(send_body=False)
+
+    def do_GET(self):
+        self.handle_request(send_body=True)
+
+    def handle_request(self, send_body):
+        with LOCK:
+            STATS["requests"] += 1
+        parts = self.path.split("?")[0].lstrip("/").split("/", 1)
+        mode = parts[0]
+        if mode == "_stats":
+            with LOCK:
+                body = json.dumps(STATS).encode()
+            return self.send_bytes(200, body, send_body=send_body)
+        if mode == "_reset":
+            with LOCK:
+                STATS["connections"] = 0
+                STATS["requests"] = 0
+                FLAKY.clear()
+            return self.send_bytes(200, b"{}", send_body=send_body)
+        rel = parts[1] if len(parts) > 1 else ""
+        path = os.path.realpath(os.path.join(ROOT, rel))
+        if mode == "missing" or not path.startswith(ROOT + os.sep) or not os.path.isfile(path):
+            return self.send_bytes(404, b"not found", send_body=send_body)
+        if mode == "fail":
+            return self.send_bytes(500, b"server error", send_body=send_body)
+        if mode == "flaky":
+            with LOCK:
+                FLAKY[rel] = FLAKY.get(rel, 0) + 1
+                n = FLAKY[rel]
+            if n <= 2:
+                return self.send_bytes(500, b"try again", send_body=send_body)
+        if mode == "stall":
+            time.sleep(60)
+            return
+        size = os.path.getsize(path)
+
+        def read(first, count):
+            # Only the bytes sent: whole-file reads would make every range request cost the file.
+            with open(path, "rb") as f:
+                f.seek(first)
+                return f.read(count)
+
+        if mode == "truncate":
+            self.send_response(200)
+            self.send_header("Content-Length", str(size))
+            self.send_header("Connection", "close")
+            self.end_headers()
+            if send_body:
+                self.wfile.write(read(0, size // 2))
+                self.wfile.flush()
+            self.close_connection = True
+            return
+        if mode not in ("ok", "flaky", "norange"):
+            return self.send_bytes(400, b"unknown mode", send_body=send_body)
+        rng = self.headers.get("Range")
+        if mode == "norange" or rng is None:
+            if not send_body:  # HEAD: the size without reading the file
+                self.send_response(200)
+                self.send_header("Content-Length", str(size))
+                self.send_header("Accept-Ranges", "bytes")
+                self.end_headers()
+                return
+            return self.send_bytes(200, read(0, size), [("Accept-Ranges", "bytes")])
+        m = re.fullmatch(r"bytes=(\d+)-(\d*)", rng.strip())
+        if not m:
+            return self.send_bytes(400, b"bad range", send_body=send_body)
+        first = int(m.group(1))
+        last = int(m.group(2)) if m.group(2) else size - 1
+        if first >= size:
+            return self.send_bytes(416, b"", [("Content-Range", "bytes */%d" % size)], send_body)
+        last = min(last, size - 1)
+        self.send_bytes(206, read(first, last + 1 - first),
+                        [("Content-Range", "bytes %d-%d/%d" % (first, last, size))], send_body)
+
+
+class Server(http.server.ThreadingHTTPServer):
+    daemon_threads = True
+
+    def handle_error(self, request, client_address):
+        pass  # clients abort transfers on purpose (size limits, ranges from a 200 answer)
+
+
+def main():
+    server = Server(("127.0.0.1", 0), Handler)
+    print("PORT %d" % server.server_address[1], flush=True)
+
+    def watch_parent():
+        sys.stdin.read()
+        os._exit(0)
+
+    threading.Thread(target=watch_parent, daemon=True).start()
+    server.serve_forever()
+
+
+if __name__ == "__main__":
+    main()
