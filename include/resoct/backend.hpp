@@ -87,6 +87,8 @@ struct BackendStats {
   std::uint64_t cap_hits = 0;  ///< rays stopped by the iteration cap (must stay 0)
   std::uint64_t request_inserts = 0;
   std::uint64_t requests_dropped = 0;
+  std::uint64_t gradient_evals = 0;  ///< gradients computed (shading, isosurface normals)
+  std::uint64_t shadow_rays = 0;     ///< shadow rays cast
   double distance_skipped = 0.0;  ///< box units
   double distance_marched = 0.0;  ///< box units
   double ms_render = 0.0;         ///< host wall time of render()

@@ -1,6 +1,8 @@
 #include "resoct/cpu/cpu_backend.hpp"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -11,6 +13,7 @@
 #include <omp.h>
 
 #include "resoct/error.hpp"
+#include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 
 namespace resoct::cpu::detail {
@@ -142,6 +145,71 @@ namespace {
 
 constexpr std::uint32_t kTile = 16;
 
+// Sums of the per-ray statistics of one frame.
+struct RayTotals {
+  std::uint64_t samples = 0, nodes = 0, accesses = 0, iterations = 0, caps = 0, requests = 0;
+  std::uint64_t gradients = 0, shadow_rays = 0;
+  double skipped = 0.0, marched = 0.0;
+};
+
+// All tiles of one frame with the kernel specialized for the effect mask EFFECTS: the mask is
+// chosen once per frame (render()), so no sample ever branches on it at run time.
+template <std::uint32_t EFFECTS>
+RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
+  const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
+  const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
+  const std::int64_t tile_count = std::int64_t(tiles_x) * tiles_y;
+  std::uint64_t samples = 0, nodes = 0, accesses = 0, iterations = 0, caps = 0, requests = 0;
+  std::uint64_t gradients = 0, shadow_rays = 0;
+  double skipped = 0.0, marched = 0.0;
+  // Row-major tile order with dynamic scheduling: neighbouring tiles (coherent rays) run close
+  // in time, and uneven tiles (empty vs. dense) balance.
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)                         \
+    reduction(+ : samples, nodes, accesses, iterations, caps, requests, skipped, marched, \
+                  gradients, shadow_rays)
+  for (std::int64_t tile = 0; tile < tile_count; ++tile) {
+    const std::uint32_t tx = std::uint32_t(tile % tiles_x) * kTile;
+    const std::uint32_t ty = std::uint32_t(tile / tiles_x) * kTile;
+    const std::uint32_t x1 = std::min(tx + kTile, frame.width);
+    const std::uint32_t y1 = std::min(ty + kTile, frame.height);
+    for (std::uint32_t y = ty; y < y1; ++y) {
+      for (std::uint32_t x = tx; x < x1; ++x) {
+        kernel::ResoctRayStats st{};
+        const glm::vec4 p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
+        // The image holds straight alpha (docs/rendering.md "Compositing").
+        pixels[std::size_t(y) * frame.width + x] =
+            p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
+        samples += st.samples;
+        nodes += st.nodes;
+        accesses += st.brick_accesses;
+        iterations += st.iterations;
+        caps += st.cap_hits;
+        requests += st.requests;
+        skipped += double(st.skipped);
+        marched += double(st.marched);
+        if constexpr (EFFECTS != 0u) {
+          gradients += st.gradient_evals;
+          shadow_rays += st.shadow_rays;
+        }
+      }
+    }
+  }
+  return {samples, nodes, accesses, iterations, caps, requests, gradients, shadow_rays,
+          skipped, marched};
+}
+
+using TileRenderer = RayTotals (*)(const kernel::ResoctFrame&, glm::vec4*, int);
+
+template <std::uint32_t... Masks>
+constexpr std::array<TileRenderer, sizeof...(Masks)> make_renderers(
+    std::integer_sequence<std::uint32_t, Masks...>) {
+  return {&render_tiles<Masks>...};
+}
+
+// One instantiation per effect mask (kernel/effects.glsl.h), built at compile time.
+constexpr auto kRenderers =
+    make_renderers(std::make_integer_sequence<std::uint32_t, kernel::RESOCT_EFFECT_MASKS>());
+
 template <class T>
 void resize_zeroed(std::vector<T>& v, std::size_t n, const char* what) {
   try {
@@ -272,52 +340,22 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
     result.image = Image(frame.width, frame.height);
   }
   glm::vec4* pixels = result.image.pixels().data();
-  const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
-  const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
-  const std::int64_t tile_count = std::int64_t(tiles_x) * tiles_y;
-
-  std::uint64_t samples = 0, nodes = 0, accesses = 0, iterations = 0, caps = 0, requests = 0;
-  double skipped = 0.0, marched = 0.0;
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
-  // Row-major tile order with dynamic scheduling: neighbouring tiles (coherent rays) run close
-  // in time, and uneven tiles (empty vs. dense) balance.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) \
-    reduction(+ : samples, nodes, accesses, iterations, caps, requests, skipped, marched)
-  for (std::int64_t tile = 0; tile < tile_count; ++tile) {
-    const std::uint32_t tx = std::uint32_t(tile % tiles_x) * kTile;
-    const std::uint32_t ty = std::uint32_t(tile / tiles_x) * kTile;
-    const std::uint32_t x1 = std::min(tx + kTile, frame.width);
-    const std::uint32_t y1 = std::min(ty + kTile, frame.height);
-    for (std::uint32_t y = ty; y < y1; ++y) {
-      for (std::uint32_t x = tx; x < x1; ++x) {
-        kernel::ResoctRayStats st{};
-        const glm::vec4 p = kernel::resoct_render_pixel(frame, x, y, st);
-        // The image holds straight alpha (docs/rendering.md "Compositing").
-        pixels[std::size_t(y) * frame.width + x] =
-            p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
-        samples += st.samples;
-        nodes += st.nodes;
-        accesses += st.brick_accesses;
-        iterations += st.iterations;
-        caps += st.cap_hits;
-        requests += st.requests;
-        skipped += double(st.skipped);
-        marched += double(st.marched);
-      }
-    }
-  }
+  const RayTotals r = kRenderers[frame.effects & kernel::RESOCT_EFFECT_ANY](frame, pixels, threads);
 
   BackendStats& s = result.stats;
   s = BackendStats{};
   s.rays = std::uint64_t(frame.width) * frame.height;
-  s.samples = samples;
-  s.nodes_visited = nodes;
-  s.brick_accesses = accesses;
-  s.iterations = iterations;
-  s.cap_hits = caps;
-  s.request_inserts = requests;
-  s.distance_skipped = skipped;
-  s.distance_marched = marched;
+  s.samples = r.samples;
+  s.nodes_visited = r.nodes;
+  s.brick_accesses = r.accesses;
+  s.iterations = r.iterations;
+  s.cap_hits = r.caps;
+  s.request_inserts = r.requests;
+  s.gradient_evals = r.gradients;
+  s.shadow_rays = r.shadow_rays;
+  s.distance_skipped = r.skipped;
+  s.distance_marched = r.marched;
 
   const std::uint32_t level_count = frame.level_count;
   RequestBatch bricks = brick_requests_->drain([level_count](std::uint32_t key) {

@@ -145,7 +145,7 @@ TEST_F(SceneFiles, InvalidFieldsNameTheirJsonPath) {
        "channels[0].levels: levels must be in 0..31"},
       {R"("channel": 0)", R"("channel": 256)", "channels[0].channel: must be in 0..255"},
       {R"("channel": 0)", R"("channel": 1.5)", "channels[0].channel: must be an integer"},
-      {R"("importance": 0)", R"("importance": 0, "mode": "mip")", "channels[0].mode: 'mip'"},
+      {R"("importance": 0)", R"("importance": 0, "mode": "xray")", "channels[0].mode: 'xray' is not a mode"},
       {R"("importance": 0)", R"("importance": 0, "colour": 1)", "channels[0].colour: unknown key"},
       {R"("step_scale": 1.0)", R"("step_scale": 0)", "scene.json: step_scale: 0 outside"},
       {R"("step_scale": 1.0)", R"("step_scale": -2)", "step_scale: -2 outside"},

@@ -106,6 +106,20 @@ struct ResoctFrame {
   // 1 = greedy (the target and every coarser level's brick at the sample position up to the
   // first one that is present or the channel's coarsest level). Added by the traversal kernel.
   uint request_greedy;
+
+  // Effects (kernel/effects.glsl.h; docs/rendering.md "Effects"). Only the kernel
+  // specializations whose RESOCT_EFFECTS include the matching bit read these.
+  uint effects;           // RESOCT_EFFECT_* bits these tables were built for
+  uint light_kind;        // RESOCT_LIGHT_*
+  float light_x;          // directional: direction the light travels; point: position (box)
+  float light_y;
+  float light_z;
+  float ambient;          // Blinn-Phong coefficients
+  float diffuse;
+  float specular;
+  float shininess;
+  uint gradient_forward;  // 1: forward differences (3 lookups), 0: central (6 lookups)
+  uint shadow_lod_shift;  // shadow rays march the view LOD level + this (paper 004 §7.2)
 };
 
 // One visible channel, in importance order (slot table index 0 is traversed first).
@@ -118,6 +132,13 @@ struct ResoctSlotInfo {
   uint vis_hi16;   //   lo rounded down, hi rounded up; vis_lo16 > vis_hi16 = never visible
   float range_lo;  // raw voxel value -> normalized: (raw - range_lo) * inv_range_width
   float inv_range_width;
+  // Effects: RESOCT_CHANNEL_* mode and up to RESOCT_MAX_ISOVALUES normalized isovalues (iso).
+  uint mode;
+  uint iso_count;
+  float iso0;
+  float iso1;
+  float iso2;
+  float iso3;
 };
 
 // One brick-hierarchy level.
@@ -162,6 +183,8 @@ struct ResoctRayStats {
   uint requests;        // request inserts attempted
   float skipped;        // box-space distance skipped as empty
   float marched;        // box-space distance marched inside the volume
+  uint gradient_evals;  // gradients computed (shading, isosurface normals)
+  uint shadow_rays;     // shadow rays cast
 };
 
 RESOCT_KERNEL_END
