@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the Vulkan instance/device a VulkanBackend renders with (own or adopted), the
-// validation messenger, and host-visible storage buffers.
+// validation messenger, and the VkResult check.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -45,22 +45,5 @@ std::unique_ptr<Context> create_context(const BackendOptions& options);
 /// Wraps caller-owned handles.
 std::unique_ptr<Context> adopt_context(VkInstance instance, VkPhysicalDevice physical,
                                        VkDevice device, std::uint32_t family);
-
-/// A persistently mapped, host-coherent storage buffer.
-struct Buffer {
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  void* mapped = nullptr;
-  VkDeviceSize size = 0;
-};
-
-/// The memory type buffers use: host-visible + coherent, device-local where such a type exists
-/// (integrated GPUs, CPU devices, resizable BAR), else plain host-visible.
-std::uint32_t buffer_memory_type(const Context& c, std::uint32_t type_bits);
-/// Throws Error(out_of_memory) when `bytes` more would not fit the heap of the buffer memory
-/// type (its VK_EXT_memory_budget budget where available, else its size).
-void check_budget(const Context& c, VkDeviceSize bytes);
-Buffer create_buffer(const Context& c, VkDeviceSize bytes, const char* what);
-void destroy_buffer(const Context& c, Buffer& b) noexcept;
 
 }  // namespace resoct::vk::detail

@@ -7,6 +7,8 @@
 
 #include "vulkan_test_util.hpp"
 #include "support/expect_error.hpp"
+#include "resoct/procedural_source.hpp"
+#include "resoct/scene.hpp"
 
 namespace resoct::test {
 namespace {
@@ -146,6 +148,37 @@ TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
   cfg.cache_slots = 20;
   gpu->debug_limit_cache_buffer(64);
   EXPECT_RESOCT_ERROR(gpu->configure(cfg), ErrorCode::out_of_memory, "buffers");
+  expect_no_validation_messages(*gpu);
+}
+
+// Render pipelines are cached per specialization-constant variant: the same configuration reuses
+// its pipeline, another brick size compiles a second one, and returning to the first compiles
+// nothing and renders the same image.
+TEST(VulkanState, PipelineVariantsAreCompiledOnceAndReused) {
+  auto gpu = make_validated_vulkan();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  auto layout = [](std::uint32_t brick) {
+    BrickLayout l;
+    l.brick_size = glm::uvec3(brick);
+    l.halo = 1;
+    return l;
+  };
+  Scene scene = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/sphere.json");
+  scene.viewport = Viewport{12, 10};
+  ProceduralSource src8("procedural:sphere:16x16x16", layout(8));
+  ProceduralSource src4("procedural:sphere:16x16x16", layout(4));
+  ResidentScene rs8(src8, {0});
+  ResidentScene rs4(src4, {0});
+  EXPECT_EQ(gpu->debug_pipeline_count(), 0u);  // built lazily by the first render
+  const FrameResult first = render_on(*gpu, rs8, scene, {});
+  EXPECT_GT(first.stats.samples, 0u);
+  render_on(*gpu, rs8, scene, {});
+  EXPECT_EQ(gpu->debug_pipeline_count(), 1u);
+  render_on(*gpu, rs4, scene, {});
+  EXPECT_EQ(gpu->debug_pipeline_count(), 2u);
+  const FrameResult again = render_on(*gpu, rs8, scene, {});
+  EXPECT_EQ(gpu->debug_pipeline_count(), 2u);
+  EXPECT_EQ(again.image.pixels(), first.image.pixels());
   expect_no_validation_messages(*gpu);
 }
 

@@ -6,6 +6,7 @@
 /// maxStorageBufferRange) holding voxels of the configured type filtered in the
 /// shader exactly like the CPU backend, so the CPU backend is its test oracle.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -68,6 +69,10 @@ class VulkanBackend : public Backend {
   /// maxStorageBufferRange) from the next configure() on, so that tests exercise a cache split
   /// over several buffers. 0 restores the default.
   void debug_limit_cache_buffer(std::uint64_t bytes) noexcept;
+  /// Test support: render pipelines compiled so far. Pipelines are cached per distinct set of
+  /// specialization constants (voxel type, padded brick, cache buffers, ...), so reconfiguring
+  /// back to an earlier configuration compiles nothing.
+  std::size_t debug_pipeline_count() const noexcept;
 
   struct Impl;
 
