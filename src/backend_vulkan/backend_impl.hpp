@@ -58,7 +58,7 @@ constexpr std::uint32_t kWorkgroup = 8;
 // kernel/tf.glsl.h RESOCT_TF_LUT_SIZE (that header needs the accessors, which live in the shader).
 constexpr std::size_t kTfLutSize = 1024;
 constexpr std::uint32_t kMaxProbes = 16;  // RequestSet's default, which the CPU backend uses
-constexpr std::uint32_t kStatWords = 20;
+constexpr std::uint32_t kStatWords = 24;
 constexpr double kDistanceScale = 1048576.0;  // shaders/render.comp DISTANCE_SCALE
 constexpr std::uint64_t kFenceTimeoutNs = 120ull * 1000 * 1000 * 1000;
 

@@ -11,6 +11,7 @@
 
 #include "backend_impl.hpp"
 #include "resoct/error.hpp"
+#include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::vk {
@@ -140,7 +141,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.configured = true;
 }
 
-RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& /*tables*/) const {
+RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& tables) const {
   RenderVariant v;
   v.voxel_type = std::uint32_t(config.voxel_type);
   v.padded_x = config.padded_brick.x;
@@ -149,6 +150,7 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& /*tables*/)
   v.cache_chunks = chunks;
   v.workgroup_x = kWorkgroup;
   v.workgroup_y = kWorkgroup;
+  v.effects = tables.frame.effects & kernel::RESOCT_EFFECT_ANY;
   return v;
 }
 

@@ -111,6 +111,8 @@ const uint STAT_BRICK_DROPPED = 12u;
 const uint STAT_NODE_DROPPED = 14u;
 const uint STAT_SKIPPED = 16u;  // box units * 2^20, rounded per ray
 const uint STAT_MARCHED = 18u;
+const uint STAT_GRADIENTS = 20u;
+const uint STAT_SHADOW_RAYS = 22u;
 const float DISTANCE_SCALE = 1048576.0;
 
 // Exact 64-bit sums without 64-bit atomics: a carry out of the low word bumps the high word.
@@ -257,7 +259,8 @@ void main() {
   uvec2 px = gl_GlobalInvocationID.xy;
   if (px.x >= frame.width || px.y >= frame.height) return;
   ResoctRayStats st;
-  vec4 p = resoct_render_pixel(frame, px.x, px.y, st);
+  // RESOCT_EFFECTS (constant_id 30, kernel/effects.glsl.h) selects the effect specialization.
+  vec4 p = resoct_render_pixel_fx(frame, px.x, px.y, st);
   // The image holds straight alpha, as the CPU backend writes it.
   pixels[px.y * frame.width + px.x] = p.a > 0.0 ? vec4(p.rgb / p.a, p.a) : vec4(0.0);
   stat_add(STAT_SAMPLES, st.samples);
@@ -268,4 +271,6 @@ void main() {
   stat_add(STAT_REQUESTS, st.requests);
   stat_add(STAT_SKIPPED, uint(round(st.skipped * DISTANCE_SCALE)));
   stat_add(STAT_MARCHED, uint(round(st.marched * DISTANCE_SCALE)));
+  stat_add(STAT_GRADIENTS, st.gradient_evals);
+  stat_add(STAT_SHADOW_RAYS, st.shadow_rays);
 }
