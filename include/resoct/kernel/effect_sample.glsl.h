@@ -34,7 +34,6 @@ RESOCT_KERNEL_BEGIN
 struct ResoctFxRay {
   float prev_v[RESOCT_MAX_SLOTS];    // iso: the channel's previous value
   float prev_t[RESOCT_MAX_SLOTS];    // iso: its sample parameter
-  uint prev_level[RESOCT_MAX_SLOTS];  // iso: its level
   uint have_prev;                    // iso: slots with a previous value
   float proj[RESOCT_MAX_SLOTS];      // mip: running maximum; aip: integral of the value
 };
@@ -54,7 +53,6 @@ RESOCT_FN void resoct_fx_ray_clear(RESOCT_OUT(ResoctFxRay) fx) {
   for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) {
     fx.prev_v[i] = 0.0f;
     fx.prev_t[i] = 0.0f;
-    fx.prev_level[i] = 0u;
     fx.proj[i] = 0.0f;
   }
 }
@@ -86,57 +84,46 @@ RESOCT_FX_FN vec3 resoct_fx_shade(ResoctSampleParams sp, ResoctFxParams p, Resoc
   return resoct_blinn_phong(p, rgb, g, light, rc.dir_box, shadow);
 }
 
-/// Iso channel at a sample: bracket against the previous sample, refine, composite the surface.
-RESOCT_FX_FN void resoct_fx_iso(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
-                                uint c, ResoctSlotInfo s, float value, uint level, uint lod,
-                                float tm, RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(vec4) acc,
-                                RESOCT_INOUT(ResoctRayStats) st) {
+/// Iso channel at a sample: brackets a crossing against the channel's previous sample and
+/// refines it. When the two samples straddle several isovalues, the one nearest the previous
+/// value (crossed first by a monotone field) is refined, the others are not drawn in this step.
+/// True with the hit's parameter and isovalue; the current sample becomes the previous one
+/// either way. One refinement per call keeps the inlined GPU code small.
+RESOCT_FN bool resoct_fx_iso_hit(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
+                                 uint c, ResoctSlotInfo s, float value, uint level, float tm,
+                                 RESOCT_INOUT(ResoctFxRay) fx, RESOCT_OUT(float) t_hit,
+                                 RESOCT_OUT(float) iso_hit) {
+  t_hit = tm;
+  iso_hit = 0.0f;
+  bool found = false;
+  float pv = fx.prev_v[c];
+  float pt = fx.prev_t[c];
   if (((fx.have_prev >> c) & 1u) != 0u) {
-    float pv = fx.prev_v[c];
-    float pt = fx.prev_t[c];
-    float best = RESOCT_RAY_T_INF;
-    float best_iso = 0.0f;
-    uint best_level = level;
     for (uint k = 0u; k < s.iso_count && k < RESOCT_MAX_ISOVALUES; ++k) {
       float x = resoct_isovalue(s, k);
       if ((pv < x) == (value < x)) continue;
-      float th;
-      uint lv = level;
-      bool ok = resoct_iso_refine(sp, p, s, level, x, rc.o_cell, rc.o_frac, rc.dir_vox, pt, tm, th);
-      if (!ok && fx.prev_level[c] != level) {
-        lv = fx.prev_level[c];
-        ok = resoct_iso_refine(sp, p, s, lv, x, rc.o_cell, rc.o_frac, rc.dir_vox, pt, tm, th);
-      }
-      // The samples disagree across a level change or a missing brick: interpolate linearly so
-      // that the surface has no hole.
-      if (!ok) th = pt + (tm - pt) * clamp((x - pv) / (value - pv), 0.0f, 1.0f);
-      if (th < best) {
-        best = th;
-        best_iso = x;
-        best_level = lv;
-      }
-    }
-    if (best < RESOCT_RAY_T_INF) {
-      ivec3 hc;
-      vec3 hf;
-      resoct_ray_position(rc.o_cell, rc.o_frac, rc.dir_vox, best, hc, hf);
-      resoct_fx_clamp(p, hc, hf);
-      vec4 rgba = resoct_tf_lookup(s.slot, best_iso);
-      if (rgba.a > 0.0f) {
-        vec3 rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, best_level, lod, hc, hf, best_iso,
-                                              vec3(rgba.r, rgba.g, rgba.b), true, st);
-        acc = resoct_composite(acc, resoct_premultiply(rgb, min(rgba.a, 1.0f)));
-      }
+      if (!found || abs(x - pv) < abs(iso_hit - pv)) iso_hit = x;
+      found = true;
     }
   }
   fx.prev_v[c] = value;
   fx.prev_t[c] = tm;
-  fx.prev_level[c] = level;
   fx.have_prev = fx.have_prev | (1u << c);
+  if (!found) return false;
+  // Refined on the level of the current sample; when the samples come from different levels
+  // (an LOD transition or a substitution) or a brick is missing, the trilinear cells may hold
+  // no root: interpolate linearly then, so that the surface has no hole.
+  if (!resoct_iso_refine(sp, p, s, level, iso_hit, rc.o_cell, rc.o_frac, rc.dir_vox, pt, tm,
+                         t_hit)) {
+    t_hit = pt + (tm - pt) * clamp((iso_hit - pv) / (value - pv), 0.0f, 1.0f);
+  }
+  return true;
 }
 
 /// One channel's value at a sample under the declared effects (see the file comment). `level`
-/// is the level the value came from, `lod` the view LOD level, `seg` the segment length.
+/// is the level the value came from, `lod` the view LOD level, `seg` the segment length. The
+/// lighting code appears once (one call of resoct_fx_shade) so that GPU compilers, which inline
+/// everything, compile it once.
 RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
                                     uint c, ResoctSlotInfo s, float value, uint level, uint lod,
                                     float seg, float tm, ivec3 cell, vec3 frac,
@@ -153,22 +140,35 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
       return;
     }
   }
+  bool surface = false;
+  ivec3 pc = cell;
+  vec3 pf = frac;
+  uint pl = level;
+  float pv = value;
   RESOCT_IF_FX(RESOCT_EFFECT_ISO) {
     if (s.mode == RESOCT_CHANNEL_ISO) {
-      RESOCT_FX(resoct_fx_iso)(sp, p, rc, c, s, value, level, lod, tm, fx, acc, st);
-      return;
+      float th;
+      if (!resoct_fx_iso_hit(sp, p, rc, c, s, value, level, tm, fx, th, pv)) return;
+      resoct_ray_position(rc.o_cell, rc.o_frac, rc.dir_vox, th, pc, pf);
+      resoct_fx_clamp(p, pc, pf);
+      surface = true;
     }
   }
-  vec4 rgba = resoct_tf_lookup(s.slot, value);
-  float a = resoct_correct_opacity(rgba.a, seg / p.ref_step);
+  vec4 rgba = resoct_tf_lookup(s.slot, pv);
+  // A surface keeps its TF alpha; a DVR sample's alpha is corrected for the segment.
+  float a = surface ? min(rgba.a, 1.0f) : resoct_correct_opacity(rgba.a, seg / p.ref_step);
   vec3 rgb = vec3(rgba.r, rgba.g, rgba.b);
-  RESOCT_IF_FX(RESOCT_EFFECT_SHADING) {
-    if (a > 0.0f) {
-      rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, level, lod, cell, frac, value, rgb,
-                                       a > RESOCT_SHADOW_MIN_ALPHA, st);
-    }
+  bool lit = surface;
+  RESOCT_IF_FX(RESOCT_EFFECT_SHADING) { lit = true; }
+  if (lit && a > 0.0f) {
+    rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, pl, lod, pc, pf, pv, rgb,
+                                     surface || a > RESOCT_SHADOW_MIN_ALPHA, st);
   }
-  resoct_mix_add(weighted, combined, rgb, a);
+  if (surface) {
+    acc = resoct_composite(acc, resoct_premultiply(rgb, a));
+  } else {
+    resoct_mix_add(weighted, combined, rgb, a);
+  }
 }
 
 /// MIP/AIP results behind the accumulated colour. `length` is the ray's length in the volume.

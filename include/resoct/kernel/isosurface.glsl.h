@@ -159,25 +159,23 @@ RESOCT_FN bool resoct_iso_refine(ResoctSampleParams sp, ResoctFxParams p, Resoct
     int a = t_next.x <= t_next.y ? (t_next.x <= t_next.z ? 0 : 2) : (t_next.y <= t_next.z ? 1 : 2);
     float tb = min(max(t_next[a], ta), t1);
     if (tb > ta) {
+      // The cubic through four samples of the cell's interval (one call site: small GPU code).
       float hs = (tb - ta) / 3.0f;
-      float g0;
-      float g1;
-      float g2;
-      float g3;
-      bool ok = resoct_iso_value_at(sp, p, s, level, o_cell, o_frac, dir_vox, ta, g0);
-      ok = resoct_iso_value_at(sp, p, s, level, o_cell, o_frac, dir_vox, ta + hs, g1) && ok;
-      ok = resoct_iso_value_at(sp, p, s, level, o_cell, o_frac, dir_vox, ta + 2.0f * hs, g2) && ok;
-      ok = resoct_iso_value_at(sp, p, s, level, o_cell, o_frac, dir_vox, tb, g3) && ok;
+      float g[4];
+      bool ok = true;
+      for (int j = 0; j < 4; ++j) {
+        float v;
+        ok = resoct_iso_value_at(sp, p, s, level, o_cell, o_frac, dir_vox,
+                                 j == 3 ? tb : ta + float(j) * hs, v) &&
+             ok;
+        g[j] = v - iso;
+      }
       if (ok) {
-        g0 = g0 - iso;
-        g1 = g1 - iso;
-        g2 = g2 - iso;
-        g3 = g3 - iso;
         // Newton forward differences on the nodes s = 0, 1, 2, 3, converted to powers of s.
-        float d1 = g1 - g0;
-        float d2 = g2 - 2.0f * g1 + g0;
-        float d3 = g3 - 3.0f * g2 + 3.0f * g1 - g0;
-        vec4 c = vec4(g0, d1 - 0.5f * d2 + d3 / 3.0f, 0.5f * d2 - 0.5f * d3, d3 / 6.0f);
+        float d1 = g[1] - g[0];
+        float d2 = g[2] - 2.0f * g[1] + g[0];
+        float d3 = g[3] - 3.0f * g[2] + 3.0f * g[1] - g[0];
+        vec4 c = vec4(g[0], d1 - 0.5f * d2 + d3 / 3.0f, 0.5f * d2 - 0.5f * d3, d3 / 6.0f);
         float r = resoct_cubic_first_root(c, 3.0f);
         if (r >= 0.0f) {
           t_hit = ta + r * hs;

@@ -151,6 +151,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     resoct_mix_begin(weighted, combined);
     bool any_value = false;
     bool skip = false;
+    // Effects: the channels' values are collected and handled by one call below, so the GPU
+    // compiler inlines the effect code once, not once per render mode.
+    float fx_value[RESOCT_MAX_SLOTS];
+    uint fx_level[RESOCT_MAX_SLOTS];
+    uint fx_have = 0u;
     float skip_exit = RESOCT_RAY_T_INF;
 
     if (f.mode == RESOCT_MODE_RESIDENCY) {
@@ -269,8 +274,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
                 level = resoct_present_level(sp, s, node, target, cell);
               }
-              RESOCT_FX(resoct_fx_channel)(sp, fxp, rc, c, s, value, level, lod, seg, tm, cell,
-                                           frac, fx, weighted, combined, acc, stats);
+              fx_value[c] = value;
+              fx_level[c] = level;
+              fx_have = fx_have | (1u << c);
             } else {
               vec4 rgba = resoct_tf_lookup(s.slot, value);
               resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
@@ -309,8 +315,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
               if (f.mode == RESOCT_MODE_OCTREE) level = resoct_octree_level(sp, s, target, cell);
             }
-            RESOCT_FX(resoct_fx_channel)(sp, fxp, rc, c, s, value, level, lod, seg, tm, cell,
-                                         frac, fx, weighted, combined, acc, stats);
+            fx_value[c] = value;
+            fx_level[c] = level;
+            fx_have = fx_have | (1u << c);
           } else {
             vec4 rgba = resoct_tf_lookup(s.slot, value);
             resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
@@ -320,6 +327,15 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         }
       }
       skip = all_empty;
+    }
+
+    RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+      for (uint c = 0u; c < n; ++c) {
+        if (((fx_have >> c) & 1u) == 0u) continue;
+        RESOCT_FX(resoct_fx_channel)(sp, fxp, rc, c, resoct_read_slot(c), fx_value[c],
+                                     fx_level[c], lod, seg, tm, cell, frac, fx, weighted,
+                                     combined, acc, stats);
+      }
     }
 
     if (any_value) {
