@@ -38,10 +38,18 @@ using namespace resoct;
 using namespace resoct::bench;
 
 constexpr const char* kNames[] = {"tubes", "turbulence", "cells"};
-constexpr const char* kConfigs[] = {
-    "plain",           "plain (repeat)",      "shading central",   "shading forward",
-    "shadows x1",      "shadows x2",          "shadows x4",        "iso",
-    "iso+shadows x2",  "mip",                 "aip",               "combined"};
+constexpr const char* kConfigs[] = {"plain",
+                                    "plain (repeat)",
+                                    "shading central",
+                                    "shading forward",
+                                    "shadows x1",
+                                    "shadows x2",
+                                    "shadows x4",
+                                    "iso",
+                                    "iso+shadows x2",
+                                    "mip",
+                                    "aip",
+                                    "combined"};
 constexpr int kConfigCount = 12;
 
 std::string spec_for(int dataset) {
@@ -141,7 +149,8 @@ void BM_Effects(benchmark::State& state) {
   state.counters["shadow_rays_per_ray"] = double(first.stats.shadow_rays) / rays;
   auto error_vs = [&](int other, const char* name) {
     const auto it = g_images.find({dataset, other});
-    if (it != g_images.end()) state.counters[name] = compare_images(first.image, it->second).rmse_rgb;
+    if (it != g_images.end())
+      state.counters[name] = compare_images(first.image, it->second).rmse_rgb;
   };
   if (config == 3) error_vs(2, "rmse_vs_central");
   if (config == 5 || config == 6) error_vs(4, "shadow_rmse");

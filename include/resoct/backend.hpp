@@ -89,10 +89,10 @@ struct BackendStats {
   std::uint64_t requests_dropped = 0;
   std::uint64_t gradient_evals = 0;  ///< gradients computed (shading, isosurface normals)
   std::uint64_t shadow_rays = 0;     ///< shadow rays cast
-  double distance_skipped = 0.0;  ///< box units
-  double distance_marched = 0.0;  ///< box units
-  double ms_render = 0.0;         ///< host wall time of render()
-  double ms_device = 0.0;         ///< device time where measurable (timestamp queries), else 0
+  double distance_skipped = 0.0;     ///< box units
+  double distance_marched = 0.0;     ///< box units
+  double ms_render = 0.0;            ///< host wall time of render()
+  double ms_device = 0.0;            ///< device time where measurable (timestamp queries), else 0
 };
 
 /// What render() returns.

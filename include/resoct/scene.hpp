@@ -40,9 +40,9 @@ inline constexpr std::size_t kMaxIsovalues = 4;
 /// The light of "shading" and "shadows" and of isosurfaces (Blinn-Phong).
 struct Light {
   enum class Kind : std::uint8_t { headlight, directional, point };
-  Kind kind = Kind::headlight;   ///< headlight: shines along each view ray
-  glm::dvec3 vector{0.0};        ///< directional: direction the light travels; point: position (box)
-  double ambient = 0.25;         ///< each coefficient in [0, 10]
+  Kind kind = Kind::headlight;  ///< headlight: shines along each view ray
+  glm::dvec3 vector{0.0};       ///< directional: direction the light travels; point: position (box)
+  double ambient = 0.25;        ///< each coefficient in [0, 10]
   double diffuse = 0.75;
   double specular = 0.25;
   double shininess = 32.0;  ///< Blinn-Phong exponent in [1, 1024]

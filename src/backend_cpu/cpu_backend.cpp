@@ -194,8 +194,8 @@ RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int 
       }
     }
   }
-  return {samples, nodes, accesses, iterations, caps, requests, gradients, shadow_rays,
-          skipped, marched};
+  return {samples,  nodes,     accesses,    iterations, caps,
+          requests, gradients, shadow_rays, skipped,    marched};
 }
 
 using TileRenderer = RayTotals (*)(const kernel::ResoctFrame&, glm::vec4*, int);

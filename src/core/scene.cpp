@@ -182,8 +182,7 @@ void read_channel_effects(const Reader& r, const json& j, const std::string& pat
 
 Light read_light(const Reader& r, const json& j) {
   r.object(j, "light");
-  r.only_keys(j, "light",
-              {"direction", "position", "ambient", "diffuse", "specular", "shininess"});
+  r.only_keys(j, "light", {"direction", "position", "ambient", "diffuse", "specular", "shininess"});
   Light l;
   const json* dir = r.find(j, "direction");
   const json* pos = r.find(j, "position");
@@ -245,8 +244,8 @@ void check_effects(const Scene& s, const Fail& fail) {
     }
   }
   const Light& l = s.light;
-  const bool finite = std::isfinite(l.vector.x) && std::isfinite(l.vector.y) &&
-                      std::isfinite(l.vector.z);
+  const bool finite =
+      std::isfinite(l.vector.x) && std::isfinite(l.vector.y) && std::isfinite(l.vector.z);
   if (!finite) fail("light", "must be finite");
   if (l.kind == Light::Kind::directional && l.vector == glm::dvec3(0.0)) {
     fail("light.direction", "must not be zero");

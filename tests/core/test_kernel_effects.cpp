@@ -289,8 +289,8 @@ TEST(KernelEffects, SphereIsosurfaceHitsAndNormals) {
         gr[a] = (trilinear(rig.src, p + e) - trilinear(rig.src, p - e)) / 2.0;
       }
       auto angle = [](glm::dvec3 a, glm::dvec3 b) {
-        return glm::degrees(std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)),
-                                                 -1.0, 1.0)));
+        return glm::degrees(
+            std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0, 1.0)));
       };
       worst_ref_angle = std::max(worst_ref_angle, angle(glm::dvec3(gk), gr));
       worst_true_angle = std::max(worst_true_angle, angle(glm::dvec3(gk), p - centre));
@@ -299,9 +299,10 @@ TEST(KernelEffects, SphereIsosurfaceHitsAndNormals) {
     EXPECT_LE(worst_hit, 1e-3) << "halo " << halo;
     EXPECT_LE(worst_ref_angle, 0.5) << "halo " << halo;
     EXPECT_LE(worst_true_angle, 0.5) << "halo " << halo;
-    std::printf("halo %u: %d hits, max hit error %.2e voxel, normal vs reference %.3f deg, vs "
-                "analytic %.3f deg\n",
-                halo, hits, worst_hit, worst_ref_angle, worst_true_angle);
+    std::printf(
+        "halo %u: %d hits, max hit error %.2e voxel, normal vs reference %.3f deg, vs "
+        "analytic %.3f deg\n",
+        halo, hits, worst_hit, worst_ref_angle, worst_true_angle);
   }
 }
 
@@ -316,13 +317,13 @@ TEST(KernelEffects, IsovalueEqualToVoxelValues) {
   // The isovalue exactly as the kernel normalizes voxel value 9.
   const float exact = (9.0f - slot.range_lo) * slot.inv_range_width;
   float th = -1.0f;
-  ASSERT_TRUE(k::resoct_iso_refine(rig.sp(), rig.fxp(), slot, 0u, exact,
-                                   glm::ivec3(2, 7, 7), glm::vec3(0.25f, 0.5f, 0.5f),
-                                   glm::vec3(1, 0, 0), 0.0f, 20.0f, th));
+  ASSERT_TRUE(k::resoct_iso_refine(rig.sp(), rig.fxp(), slot, 0u, exact, glm::ivec3(2, 7, 7),
+                                   glm::vec3(0.25f, 0.5f, 0.5f), glm::vec3(1, 0, 0), 0.0f, 20.0f,
+                                   th));
   EXPECT_NEAR(th, 7.25, 1e-4);
-  ASSERT_TRUE(k::resoct_iso_refine(rig.sp(), rig.fxp(), slot, 0u, exact,
-                                   glm::ivec3(9, 7, 7), glm::vec3(0.5f, 0.5f, 0.5f),
-                                   glm::vec3(1, 0, 0), 0.0f, 5.0f, th));
+  ASSERT_TRUE(k::resoct_iso_refine(rig.sp(), rig.fxp(), slot, 0u, exact, glm::ivec3(9, 7, 7),
+                                   glm::vec3(0.5f, 0.5f, 0.5f), glm::vec3(1, 0, 0), 0.0f, 5.0f,
+                                   th));
   EXPECT_NEAR(th, 0.0, 1e-5);
   // An isovalue the field never reaches is never hit.
   EXPECT_FALSE(k::resoct_iso_refine(rig.sp(), rig.fxp(), slot, 0u, float(40.0 / 31.0),

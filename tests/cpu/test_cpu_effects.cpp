@@ -71,8 +71,8 @@ double brute_projection(const Scene& s, const VolumeDesc& v, const VoxelFunction
   for (double t = t0; t < t1; t += step) {
     const double seg = std::min(step, t1 - t);
     const glm::dvec3 p = (ray.origin + ray.dir * (t + 0.5 * seg)) * to_vox;
-    const double x = std::clamp((sample_trilinear(vox, 0, v.extent, p) - r.lo) / (r.hi - r.lo),
-                                0.0, 1.0);
+    const double x =
+        std::clamp((sample_trilinear(vox, 0, v.extent, p) - r.lo) / (r.hi - r.lo), 0.0, 1.0);
     best = std::max(best, x);
     sum += x * seg;
   }
@@ -98,8 +98,8 @@ TEST(CpuEffects, MipAndAipMatchBruteForceProjections) {
         if (expect < 0.0) continue;
         ++rays;
         // The grey ramp TF maps the projection to the colour (opaque, so the pixel is it).
-        worst = std::max(worst, std::abs(double(r.image.at(std::uint32_t(x), std::uint32_t(y)).r) -
-                                         expect));
+        worst = std::max(
+            worst, std::abs(double(r.image.at(std::uint32_t(x), std::uint32_t(y)).r) - expect));
       }
     }
     EXPECT_GT(rays, 100);
@@ -211,8 +211,8 @@ TEST(CpuEffects, IsosurfaceAcrossBrickBordersAndLevelTransitions) {
       const double t = (0.5 - ray.origin.x) / ray.dir.x;
       const glm::dvec3 p = ray.origin + t * ray.dir;
       const double margin = 1.0 / 32.0;  // one voxel: the ramp's clamped border
-      const bool inside = span.x < span.y && p.y > margin && p.y < 1 - margin && p.z > margin &&
-                          p.z < 1 - margin;
+      const bool inside =
+          span.x < span.y && p.y > margin && p.y < 1 - margin && p.z > margin && p.z < 1 - margin;
       const bool outside = !(span.x < span.y) || p.y < -margin || p.y > 1 + margin ||
                            p.z < -margin || p.z > 1 + margin;
       const bool hit = b.image.at(x, y).b > 0.5f;
@@ -271,7 +271,7 @@ TEST(CpuEffects, SphereShadowOnSlabWhereGeometrySays) {
       for (std::uint32_t px = 0; px < 64; ++px) {
         const glm::dvec2 p(px + 0.5, 32.0 - (py + 0.5));
         if (glm::length(p - glm::dvec2(20.0, 16.0)) < 7.0) continue;  // the ball itself
-        if (p.x < 2 || p.x > 62 || p.y < 2 || p.y > 30) continue;      // clamped borders
+        if (p.x < 2 || p.x > 62 || p.y < 2 || p.y > 30) continue;     // clamped borders
         const double d = glm::length(p - shadow);
         const double grey = r.image.at(px, py).r;
         if (d < 3.0) {

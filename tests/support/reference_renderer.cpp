@@ -212,10 +212,10 @@ glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const Vox
       const double a = rgba.a >= 1.0 ? 1.0 : -std::expm1((t1 - t0) / delta0 * std::log1p(-rgba.a));
       glm::dvec3 rgb(rgba);
       if (shading && a > 0.0) {
-        rgb = reference_shade(scene, rgb,
-                              reference_gradient(volume, voxels, c.channel,
-                                                 clamp_position(volume, pos), forward),
-                              ray.origin + ray.dir * tm, ray.dir);
+        rgb = reference_shade(
+            scene, rgb,
+            reference_gradient(volume, voxels, c.channel, clamp_position(volume, pos), forward),
+            ray.origin + ray.dir * tm, ray.dir);
       }
       transmit *= 1.0 - a;
       weight += a;
@@ -241,8 +241,8 @@ glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const Vox
     weight += a;
     weighted += a * glm::dvec3(rgba);
   }
-  if (weight > 0.0) acc += (1.0 - acc.a) * glm::dvec4(weighted * ((1.0 - transmit) / weight),
-                                                      1.0 - transmit);
+  if (weight > 0.0)
+    acc += (1.0 - acc.a) * glm::dvec4(weighted * ((1.0 - transmit) / weight), 1.0 - transmit);
   return acc;
 }
 

@@ -16,8 +16,8 @@ namespace {
 ChannelSettings channel(std::uint32_t c, ChannelMode mode, std::vector<double> iso = {}) {
   ChannelSettings s;
   s.channel = c;
-  s.tf = TransferFunction({{0.0, {0.1, 0.3, 1.0, 0.0}}, {0.25, {1.0, 0.6, 0.2, 0.05}},
-                           {1.0, {1.0, 1.0, 1.0, 0.4}}});
+  s.tf = TransferFunction(
+      {{0.0, {0.1, 0.3, 1.0, 0.0}}, {0.25, {1.0, 0.6, 0.2, 0.05}}, {1.0, {1.0, 1.0, 1.0, 0.4}}});
   s.mode = mode;
   s.isovalues = std::move(iso);
   return s;

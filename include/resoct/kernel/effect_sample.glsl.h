@@ -32,10 +32,10 @@ RESOCT_KERNEL_BEGIN
 
 /// Per-ray state of the effects.
 struct ResoctFxRay {
-  float prev_v[RESOCT_MAX_SLOTS];    // iso: the channel's previous value
-  float prev_t[RESOCT_MAX_SLOTS];    // iso: its sample parameter
-  uint have_prev;                    // iso: slots with a previous value
-  float proj[RESOCT_MAX_SLOTS];      // mip: running maximum; aip: integral of the value
+  float prev_v[RESOCT_MAX_SLOTS];  // iso: the channel's previous value
+  float prev_t[RESOCT_MAX_SLOTS];  // iso: its sample parameter
+  uint have_prev;                  // iso: slots with a previous value
+  float proj[RESOCT_MAX_SLOTS];    // mip: running maximum; aip: integral of the value
 };
 
 /// Per-ray constants of the effect code.
@@ -77,8 +77,7 @@ RESOCT_FX_FN vec3 resoct_fx_shade(ResoctSampleParams sp, ResoctFxParams p, Resoc
       if (p.light_kind == RESOCT_LIGHT_POINT) {
         max_t = length(vec3(p.light_x, p.light_y, p.light_z) - pos_box);
       }
-      shadow = resoct_shadow_transmittance(sp, p, rc.n, rc.live, cell, frac, light, max_t, lod,
-                                           st);
+      shadow = resoct_shadow_transmittance(sp, p, rc.n, rc.live, cell, frac, light, max_t, lod, st);
     }
   }
   return resoct_blinn_phong(p, rgb, g, light, rc.dir_box, shadow);
@@ -159,7 +158,9 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
   float a = surface ? min(rgba.a, 1.0f) : resoct_correct_opacity(rgba.a, seg / p.ref_step);
   vec3 rgb = vec3(rgba.r, rgba.g, rgba.b);
   bool lit = surface;
-  RESOCT_IF_FX(RESOCT_EFFECT_SHADING) { lit = true; }
+  RESOCT_IF_FX(RESOCT_EFFECT_SHADING) {
+    lit = true;
+  }
   if (lit && a > 0.0f) {
     rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, pl, lod, pc, pf, pv, rgb,
                                      surface || a > RESOCT_SHADOW_MIN_ALPHA, st);

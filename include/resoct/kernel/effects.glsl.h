@@ -8,8 +8,8 @@
 //         so the driver folds the branches when it builds the pipeline variant of a mask.
 // Spelling: declare with `RESOCT_FX_FN type name(...)`, call with `RESOCT_FX(name)(...)`, branch
 // with `RESOCT_IF_FX(RESOCT_EFFECT_X) { ... }`; RESOCT_FX_PLAIN(name) is the mask-0 version in
-// C++ and the specialization constant's in GLSL (whose default is 0). Code that never depends on the mask stays
-// RESOCT_FN.
+// C++ and the specialization constant's in GLSL (whose default is 0). Code that never depends on
+// the mask stays RESOCT_FN.
 #ifndef RESOCT_KERNEL_EFFECTS_GLSL_H
 #define RESOCT_KERNEL_EFFECTS_GLSL_H
 
@@ -17,7 +17,9 @@
 #include "resoct/kernel/frame.glsl.h"
 
 #ifdef __cplusplus
-#define RESOCT_FX_FN template <uint RESOCT_EFFECTS> inline
+#define RESOCT_FX_FN             \
+  template <uint RESOCT_EFFECTS> \
+  inline
 #define RESOCT_FX(name) name<RESOCT_EFFECTS>
 #define RESOCT_IF_FX(bit) if constexpr ((RESOCT_EFFECTS & (bit)) != 0u)
 #define RESOCT_FX_PLAIN(name) name<0u>

@@ -109,12 +109,12 @@ struct ResoctFrame {
 
   // Effects (kernel/effects.glsl.h; docs/rendering.md "Effects"). Only the kernel
   // specializations whose RESOCT_EFFECTS include the matching bit read these.
-  uint effects;           // RESOCT_EFFECT_* bits these tables were built for
-  uint light_kind;        // RESOCT_LIGHT_*
-  float light_x;          // directional: direction the light travels; point: position (box)
+  uint effects;     // RESOCT_EFFECT_* bits these tables were built for
+  uint light_kind;  // RESOCT_LIGHT_*
+  float light_x;    // directional: direction the light travels; point: position (box)
   float light_y;
   float light_z;
-  float ambient;          // Blinn-Phong coefficients
+  float ambient;  // Blinn-Phong coefficients
   float diffuse;
   float specular;
   float shininess;

@@ -56,8 +56,8 @@ RESOCT_FN float resoct_entry_normalized(ResoctSampleParams sp, ResoctSlotInfo s,
                                         float fallback) {
   uint state = resoct_page_state(entry);
   if (state == RESOCT_PAGE_STATE_MAPPED) {
-    float raw = resoct_sample_mapped(entry, L, resoct_frame_brick_size(sp), sp.halo, brick, cell,
-                                     frac);
+    float raw =
+        resoct_sample_mapped(entry, L, resoct_frame_brick_size(sp), sp.halo, brick, cell, frac);
     return resoct_normalize_value(raw, s.range_lo, s.inv_range_width);
   }
   if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) return resoct_page_homogeneous_value(entry);
@@ -84,8 +84,8 @@ RESOCT_FN bool resoct_level_value(ResoctSampleParams sp, ResoctSlotInfo s, uint 
 /// The level resoct_residency_channel samples at a position (the target if present, else the
 /// nearest partially resident one, coarser first): gradients and isosurface refinement use the
 /// level the value came from. The target when no level is present.
-RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uint node,
-                                    uint target, ivec3 cell) {
+RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uint node, uint target,
+                                    ivec3 cell) {
   uvec3 bs = resoct_frame_brick_size(sp);
   ResoctLevelInfo L = resoct_read_level(target);
   uint e = resoct_page_entry_of(s.slot, target, sp.level_count, L, resoct_brick_at(L, bs, cell));
@@ -98,8 +98,7 @@ RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uin
     while (l >= 0) {
       uint lu = uint(l);
       ResoctLevelInfo Lc = resoct_read_level(lu);
-      uint ec =
-          resoct_page_entry_of(s.slot, lu, sp.level_count, Lc, resoct_brick_at(Lc, bs, cell));
+      uint ec = resoct_page_entry_of(s.slot, lu, sp.level_count, Lc, resoct_brick_at(Lc, bs, cell));
       if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) return lu;
       l = pass == 0u ? resoct_node_next_coarser(r, lu) : resoct_node_next_finer(r, lu);
     }

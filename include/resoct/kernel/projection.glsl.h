@@ -51,8 +51,8 @@ RESOCT_FN uint resoct_projection_node_class(uint node, ResoctSlotInfo s, uint no
 /// As resoct_node_class_carried, for any channel mode: projection channels by value, the others
 /// by their visible range. `beat` is the channel's running projection value.
 RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
-                                              uvec3 coord_log2, ResoctSlotInfo s,
-                                              uint node_slots, float beat) {
+                                              uvec3 coord_log2, ResoctSlotInfo s, uint node_slots,
+                                              float beat) {
   if (!resoct_is_projection(s)) {
     return resoct_node_class_carried(node, depth, top, coord, coord_log2, s, node_slots);
   }

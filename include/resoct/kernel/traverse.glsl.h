@@ -190,7 +190,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                 cls = resoct_mode_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
                                                      resoct_read_slot(ci), f.node_slot_count,
                                                      fx.proj[ci]);
-              } else {
+              }
+              else {
                 cls = resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
                                                 resoct_read_slot(ci), f.node_slot_count);
               }
@@ -219,7 +220,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             uint cls;
             RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
               cls = resoct_mode_node_class(node, sc, f.node_slot_count, fx.proj[c]);
-            } else {
+            }
+            else {
               cls = resoct_node_class(node, sc, f.node_slot_count);
             }
             if (cls == RESOCT_NODE_CLASS_INVALID) {
@@ -227,7 +229,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
                 cls = resoct_mode_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
                                                      trav_log2, sc, f.node_slot_count, fx.proj[c]);
-              } else {
+              }
+              else {
                 cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
                                                 trav_log2, sc, f.node_slot_count);
               }
@@ -277,7 +280,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               fx_value[c] = value;
               fx_level[c] = level;
               fx_have = fx_have | (1u << c);
-            } else {
+            }
+            else {
               vec4 rgba = resoct_tf_lookup(s.slot, value);
               resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
                              resoct_correct_opacity(rgba.a, seg / f.ref_step));
@@ -318,7 +322,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             fx_value[c] = value;
             fx_level[c] = level;
             fx_have = fx_have | (1u << c);
-          } else {
+          }
+          else {
             vec4 rgba = resoct_tf_lookup(s.slot, value);
             resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
                            resoct_correct_opacity(rgba.a, seg / f.ref_step));
@@ -332,9 +337,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
       for (uint c = 0u; c < n; ++c) {
         if (((fx_have >> c) & 1u) == 0u) continue;
-        RESOCT_FX(resoct_fx_channel)(sp, fxp, rc, c, resoct_read_slot(c), fx_value[c],
-                                     fx_level[c], lod, seg, tm, cell, frac, fx, weighted,
-                                     combined, acc, stats);
+        RESOCT_FX(resoct_fx_channel)
+        (sp, fxp, rc, c, resoct_read_slot(c), fx_value[c], fx_level[c], lod, seg, tm, cell, frac,
+         fx, weighted, combined, acc, stats);
       }
     }
 
