@@ -261,21 +261,22 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           ResoctSlotInfo s = resoct_read_slot(c);
           float value = 0.0f;
           uint res = RESOCT_CH_NONE;
-          uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+          uint target = 0u;
           if (((cached_homog >> c) & 1u) != 0u) {
             uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
                                        RESOCT_NODE_MINMAX);
             value = float(resoct_node_min16(mm)) / 65535.0f;
             res = RESOCT_CH_VALUE;
           } else {
+            target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
             res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
                                            stats);
           }
           if (res == RESOCT_CH_VALUE) {
             RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-              uint level = target;
+              uint level = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-                level = resoct_present_level(sp, s, node, target, cell);
+                level = resoct_present_level(sp, s, node, level, cell);
               }
               fx_value[c] = value;
               fx_level[c] = level;
