@@ -30,6 +30,7 @@ struct KernelContext {
   const kernel::ResoctLevelInfo* levels = nullptr;
   const kernel::ResoctDepthInfo* depths = nullptr;
   const glm::vec4* tf = nullptr;
+  const kernel::ResoctFxFrame* fx = nullptr;
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
   VoxelType type = VoxelType::u8;
@@ -109,6 +110,9 @@ inline ResoctDepthInfo resoct_read_depth(uint d) {
 }
 inline vec4 resoct_read_tf(uint slot, uint index) {
   return cpu::detail::g_ctx.tf[std::size_t(slot) * 1024u + index];
+}
+inline ResoctFxFrame resoct_read_fx_frame() {
+  return *cpu::detail::g_ctx.fx;
 }
 inline float resoct_read_level_size_log2(uint level) {
   return cpu::detail::g_ctx.levels[level].size_log2;

@@ -76,6 +76,8 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
          "transfer functions");
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   std::memcpy(buf[b_frame].mapped, &frame, sizeof(frame));
+  std::memcpy(static_cast<std::byte*>(buf[b_frame].mapped) + sizeof(frame), &tables.fx,
+              sizeof(tables.fx));
   std::memcpy(buf[b_slots].mapped, tables.slots.data(),
               tables.slots.size() * sizeof(tables.slots[0]));
   std::memcpy(buf[b_levels].mapped, tables.levels.data(),

@@ -135,7 +135,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
   for (std::size_t i = 0; i < sizes.size(); ++i)
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");
-  m.ensure(b_frame, sizeof(kernel::ResoctFrame), "frame constants");
+  // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
+  m.ensure(b_frame, sizeof(kernel::ResoctFrame) + sizeof(kernel::ResoctFxFrame), "frame constants");
   // The pipeline is built by the first render(): compiling the kernel takes seconds on CPU
   // devices, and a configuration that is only updated never needs it.
   m.configured = true;
@@ -150,7 +151,7 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& tables) con
   v.cache_chunks = chunks;
   v.workgroup_x = kWorkgroup;
   v.workgroup_y = kWorkgroup;
-  v.effects = tables.frame.effects & kernel::RESOCT_EFFECT_ANY;
+  v.effects = tables.fx.effects & kernel::RESOCT_EFFECT_ANY;
   return v;
 }
 

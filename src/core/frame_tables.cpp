@@ -87,7 +87,7 @@ std::uint32_t effect_mask(const Scene& scene) {
   return m;
 }
 
-void fill_effects(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFrame& f) {
+void fill_effects(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFxFrame& f) {
   f.effects = effect_mask(scene);
   if (scene.needs_gradients() && h.layout().halo == 0) {
     throw invalid_parameter("scene.effects",
@@ -192,7 +192,8 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   f.node_slot_count = channels.slot_count();
   f.request_greedy = options.request_strategy == RequestStrategy::greedy ? 1u : 0u;
   fill_camera(scene, hierarchy, f);
-  fill_effects(scene, hierarchy, f);
+  out.fx = kernel::ResoctFxFrame{};
+  fill_effects(scene, hierarchy, out.fx);
 
   f.extent_x = check_extent(volume.extent.x, "extent");
   f.extent_y = check_extent(volume.extent.y, "extent");

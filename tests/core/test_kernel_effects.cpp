@@ -51,6 +51,9 @@ inline ResoctDepthInfo resoct_read_depth(uint d) {
 inline vec4 resoct_read_tf(uint slot, uint index) {
   return test::g.tables->tf_luts[std::size_t(slot) * 1024u + index];
 }
+inline ResoctFxFrame resoct_read_fx_frame() {
+  return test::g.tables->fx;
+}
 inline float resoct_read_level_size_log2(uint l) {
   return test::g.tables->levels[l].size_log2;
 }
@@ -112,7 +115,7 @@ struct KernelRig {
     g.padded = glm::ivec3(layout.padded_size());
   }
   k::ResoctSampleParams sp() const { return k::resoct_sample_params(tables.frame); }
-  k::ResoctFxParams fxp() const { return k::resoct_fx_params(tables.frame); }
+  k::ResoctFxParams fxp() const { return k::resoct_fx_params(tables.frame, tables.fx); }
 };
 
 VolumeDesc f32_volume(glm::u64vec3 extent, double lo, double hi, glm::dvec3 spacing = {1, 1, 1}) {

@@ -90,18 +90,18 @@ struct ResoctFxParams {
   uint max_iterations;
 };
 
-RESOCT_FN ResoctFxParams resoct_fx_params(ResoctFrame f) {
+RESOCT_FN ResoctFxParams resoct_fx_params(ResoctFrame f, ResoctFxFrame e) {
   ResoctFxParams p;
-  p.light_kind = f.light_kind;
-  p.light_x = f.light_x;
-  p.light_y = f.light_y;
-  p.light_z = f.light_z;
-  p.ambient = f.ambient;
-  p.diffuse = f.diffuse;
-  p.specular = f.specular;
-  p.shininess = f.shininess;
-  p.gradient_forward = f.gradient_forward;
-  p.shadow_lod_shift = f.shadow_lod_shift;
+  p.light_kind = e.light_kind;
+  p.light_x = e.light_x;
+  p.light_y = e.light_y;
+  p.light_z = e.light_z;
+  p.ambient = e.ambient;
+  p.diffuse = e.diffuse;
+  p.specular = e.specular;
+  p.shininess = e.shininess;
+  p.gradient_forward = e.gradient_forward;
+  p.shadow_lod_shift = e.shadow_lod_shift;
   p.vpb_x = f.voxels_per_box_x;
   p.vpb_y = f.voxels_per_box_y;
   p.vpb_z = f.voxels_per_box_z;

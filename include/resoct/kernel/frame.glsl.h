@@ -106,9 +106,13 @@ struct ResoctFrame {
   // 1 = greedy (the target and every coarser level's brick at the sample position up to the
   // first one that is present or the channel's coarsest level). Added by the traversal kernel.
   uint request_greedy;
+};
 
-  // Effects (kernel/effects.glsl.h; docs/rendering.md "Effects"). Only the kernel
-  // specializations whose RESOCT_EFFECTS include the matching bit read these.
+// Effect constants of a frame (kernel/effects.glsl.h; docs/rendering.md "Effects"), a record of
+// their own: ResoctFrame is passed by value to many helpers of the plain kernel, and growing it
+// changes how the C++ compiler inlines them. Read through resoct_read_fx_frame() only by the
+// kernel specializations that use effects.
+struct ResoctFxFrame {
   uint effects;     // RESOCT_EFFECT_* bits these tables were built for
   uint light_kind;  // RESOCT_LIGHT_*
   float light_x;    // directional: direction the light travels; point: position (box)

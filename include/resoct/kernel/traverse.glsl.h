@@ -17,6 +17,7 @@
 //   void  resoct_mark_used(uint cache_slot)          the slot was sampled this frame
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
+//   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
 //
 // Per ray: the camera ray is clipped to the volume [0, extent) in voxel space relative to the
 // exact eye cell; t (box units) runs over segments of length dt (Eq. 8.2-8.3), each sampled at
@@ -122,7 +123,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     rc.dir_vox = dir_vox;
     rc.n = n;
     rc.live = live;
-    fxp = resoct_fx_params(f);
+    fxp = resoct_fx_params(f, resoct_read_fx_frame());
   }
   float t_enter = t;
 

@@ -34,6 +34,7 @@ pc;
 
 layout(std430, binding = 0) readonly buffer FrameBuf {
   ResoctFrame frame;
+  ResoctFxFrame fx_frame;  // effect constants, right after the frame (std430: scalars only)
 };
 layout(std430, binding = 1) readonly buffer Slots {
   ResoctSlotInfo slots[];
@@ -142,6 +143,9 @@ ResoctDepthInfo resoct_read_depth(uint d) {
 }
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];
+}
+ResoctFxFrame resoct_read_fx_frame() {
+  return fx_frame;
 }
 float resoct_read_level_size_log2(uint level) {
   return levels[level].size_log2;
