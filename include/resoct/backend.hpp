@@ -71,7 +71,7 @@ struct FrameUpdate {
 /// Small per-frame tables, re-sent whole every frame (built by build_frame_tables()).
 struct FrameTables {
   kernel::ResoctFrame frame{};
-  kernel::ResoctFxFrame fx{};  ///< effect constants (kernel/effects.glsl.h)
+  kernel::ResoctFxFrame fx{};                   ///< effect constants (kernel/effects.glsl.h)
   std::vector<kernel::ResoctSlotInfo> slots;    ///< visible channels in importance order
   std::vector<kernel::ResoctLevelInfo> levels;  ///< one per hierarchy level
   std::vector<kernel::ResoctDepthInfo> depths;  ///< one per octree depth
