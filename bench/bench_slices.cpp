@@ -111,7 +111,6 @@ BENCHMARK(BM_SliceLensFrame)
     ->UseRealTime();
 
 void BM_LensPaging(benchmark::State& state) {
-  cpu::register_backend();
   const std::shared_ptr<const BrickSource> source =
       make_procedural_source(tubes(paging_extent()), BrickLayout{});
   const double size = double(state.range(0)) / 1000.0;
@@ -120,7 +119,7 @@ void BM_LensPaging(benchmark::State& state) {
   double ms = 0.0;
   for (auto _ : state) {
     RendererOptions o;
-    o.backend = "cpu";
+    o.backend = backend_name();
     o.backend_options.threads = 1;
     o.loader_threads = 0;
     o.strategy = RequestStrategy::global;

@@ -105,6 +105,9 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   j["nodes_per_ray"] = per_ray(s.backend.nodes_visited, s.backend.rays);
   j["iterations_per_ray"] = per_ray(s.backend.iterations, s.backend.rays);
   j["brick_accesses_per_ray"] = per_ray(s.backend.brick_accesses, s.backend.rays);
+  // Effects (last frame): gradients computed and shadow rays cast; 0 without effects.
+  j["gradient_evals"] = s.backend.gradient_evals;
+  j["shadow_rays"] = s.backend.shadow_rays;
   j["bricks_touched"] = s.working_set_bricks;
   j["working_set_bytes"] = s.working_set_bytes;
   j["resident_bricks"] = s.resident_bricks;

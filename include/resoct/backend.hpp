@@ -74,6 +74,7 @@ struct FrameUpdate {
 /// Small per-frame tables, re-sent whole every frame (built by build_frame_tables()).
 struct FrameTables {
   kernel::ResoctFrame frame{};
+  kernel::ResoctFxFrame fx{};                   ///< effect constants (kernel/effects.glsl.h)
   std::vector<kernel::ResoctSlotInfo> slots;    ///< visible channels in importance order
   std::vector<kernel::ResoctLevelInfo> levels;  ///< one per hierarchy level
   std::vector<kernel::ResoctDepthInfo> depths;  ///< one per octree depth
@@ -90,10 +91,12 @@ struct BackendStats {
   std::uint64_t cap_hits = 0;  ///< rays stopped by the iteration cap (must stay 0)
   std::uint64_t request_inserts = 0;
   std::uint64_t requests_dropped = 0;
-  double distance_skipped = 0.0;  ///< box units
-  double distance_marched = 0.0;  ///< box units
-  double ms_render = 0.0;         ///< host wall time of render()
-  double ms_device = 0.0;         ///< device time where measurable (timestamp queries), else 0
+  std::uint64_t gradient_evals = 0;  ///< gradients computed (shading, isosurface normals)
+  std::uint64_t shadow_rays = 0;     ///< shadow rays cast
+  double distance_skipped = 0.0;     ///< box units
+  double distance_marched = 0.0;     ///< box units
+  double ms_render = 0.0;            ///< host wall time of render()
+  double ms_device = 0.0;            ///< device time where measurable (timestamp queries), else 0
 };
 
 /// What render() returns.

@@ -24,6 +24,38 @@ enum class Effect : std::uint8_t { shading, shadows };
 /// "shading" / "shadows".
 const char* to_string(Effect e) noexcept;
 
+// --- Effects (docs/scene.md "Effects") ---------------------------------------------------------
+
+/// How one channel is rendered.
+enum class ChannelMode : std::uint8_t {
+  dvr,  ///< emission-absorption volume rendering (default)
+  iso,  ///< isosurfaces at `isovalues`, shaded
+  mip,  ///< maximum intensity projection
+  aip,  ///< average intensity projection
+};
+/// "dvr" / "iso" / "mip" / "aip".
+const char* to_string(ChannelMode m) noexcept;
+
+/// Most isovalues one iso channel may have.
+inline constexpr std::size_t kMaxIsovalues = 4;
+
+/// The light of "shading" and "shadows" and of isosurfaces (Blinn-Phong).
+struct Light {
+  enum class Kind : std::uint8_t { headlight, directional, point };
+  Kind kind = Kind::headlight;  ///< headlight: shines along each view ray
+  glm::dvec3 vector{0.0};       ///< directional: direction the light travels; point: position (box)
+  double ambient = 0.25;        ///< each coefficient in [0, 10]
+  double diffuse = 0.75;
+  double specular = 0.25;
+  double shininess = 32.0;  ///< Blinn-Phong exponent in [1, 1024]
+  friend bool operator==(const Light&, const Light&) = default;
+};
+
+/// Finite differences of gradients (paper 004 §7.1).
+enum class GradientStencil : std::uint8_t { central, forward };
+
+// ------------------------------------------------------------------------------------------------
+
 /// Highest level index a scene may name (the brick key holds 5 bits of level).
 inline constexpr std::uint32_t kMaxSceneLevel = 31;
 
@@ -35,6 +67,9 @@ struct ChannelSettings {
   std::uint32_t coarsest_level = 15;  ///< coarsest; clamped to the dataset's last level
   /// Request priority among channels; lower loads first. Ties keep the channel order.
   std::int32_t importance = 0;
+  ChannelMode mode = ChannelMode::dvr;
+  /// Iso mode only: 1..kMaxIsovalues values in the channel's normalized range [0, 1].
+  std::vector<double> isovalues;
   friend bool operator==(const ChannelSettings&, const ChannelSettings&) = default;
 };
 
@@ -51,6 +86,17 @@ struct Scene {
   // Slices and lens (docs/scene.md "Slices and lens").
   std::vector<SlicePlane> slices;  ///< at most kMaxSlices planes
   std::optional<Lens> lens;        ///< none: every channel everywhere
+  // Effect parameters (docs/scene.md "Effects").
+  Light light;
+  GradientStencil gradient = GradientStencil::central;
+  /// Shadow rays march a level whose voxels are this many times the view LOD's (power of two,
+  /// 1..16; paper 004 §7.2 suggests 2).
+  std::uint32_t shadow_lod_factor = 2;
+
+  /// Whether the scene declares `e`.
+  bool has_effect(Effect e) const noexcept;
+  /// Whether any effect needs gradients: "shading" or an iso channel.
+  bool needs_gradients() const noexcept;
 
   /// Throws Error(invalid_argument) "<what>: <field>: why" when a field is out of range (the
   /// same checks as loading), `what` e.g. a file name.

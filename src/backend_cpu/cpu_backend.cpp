@@ -11,139 +11,18 @@
 #include <omp.h>
 
 #include "resoct/error.hpp"
-#include "resoct/kernel/frame.glsl.h"
+#include "kernel_access.hpp"
 
 namespace resoct::cpu::detail {
 
-// Everything the kernel's accessors read during one render(). One process-wide instance, set
-// under g_render_mutex: a plain global costs nothing per access, unlike a thread_local in a
-// shared library.
-struct KernelContext {
-  const std::uint32_t* nodes = nullptr;
-  const std::uint32_t* pages = nullptr;
-  const std::uint32_t* page_offsets = nullptr;
-  const kernel::ResoctSlotInfo* slots = nullptr;
-  const kernel::ResoctLevelInfo* levels = nullptr;
-  const kernel::ResoctDepthInfo* depths = nullptr;
-  const glm::vec4* tf = nullptr;
-  const std::byte* cache = nullptr;
-  std::size_t slot_voxels = 0;
-  VoxelType type = VoxelType::u8;
-  glm::ivec3 padded{1};
-  RequestSet* brick_requests = nullptr;
-  RequestSet* node_requests = nullptr;
-  std::atomic<std::uint64_t>* used = nullptr;
-};
-
-KernelContext g_ctx;
+__attribute__((visibility("hidden"))) KernelContext g_ctx;
 std::mutex g_render_mutex;
 
-template <class T>
-inline float load_voxel(const std::byte* base, std::size_t i) {
-  T v;
-  std::memcpy(&v, base + i * sizeof(T), sizeof(T));
-  return float(v);
-}
-
-// Clamps to [0, hi]; NaN goes to 0 so that no NaN ever becomes an index.
-inline float clamp_coord(float v, float hi) {
-  return v > 0.0f ? (v < hi ? v : hi) : 0.0f;
-}
-
-// Always inlined into the kernel's sampling: left to the growth heuristics, GCC moved it out of
-// the march once the kernel unit grew (slices and lens), +2 % instructions per frame (callgrind).
-template <class T>
-[[gnu::always_inline]] inline float trilinear(const std::byte* brick, glm::ivec3 padded,
-                                              glm::vec3 pos) {
-  // Clamp to the outermost voxel centres (clamp-to-edge), then interpolate the 2x2x2 cell.
-  const float cx = clamp_coord(pos.x - 0.5f, float(padded.x - 1));
-  const float cy = clamp_coord(pos.y - 0.5f, float(padded.y - 1));
-  const float cz = clamp_coord(pos.z - 0.5f, float(padded.z - 1));
-  const int x0 = std::min(int(cx), std::max(padded.x - 2, 0));
-  const int y0 = std::min(int(cy), std::max(padded.y - 2, 0));
-  const int z0 = std::min(int(cz), std::max(padded.z - 2, 0));
-  const std::size_t dx = x0 + 1 < padded.x ? 1u : 0u;
-  const std::size_t dy = y0 + 1 < padded.y ? std::size_t(padded.x) : 0u;
-  const std::size_t dz = z0 + 1 < padded.z ? std::size_t(padded.x) * std::size_t(padded.y) : 0u;
-  const float fx = cx - float(x0), fy = cy - float(y0), fz = cz - float(z0);
-  const std::size_t i =
-      (std::size_t(z0) * std::size_t(padded.y) + std::size_t(y0)) * std::size_t(padded.x) +
-      std::size_t(x0);
-  const float v000 = load_voxel<T>(brick, i), v100 = load_voxel<T>(brick, i + dx);
-  const float v010 = load_voxel<T>(brick, i + dy), v110 = load_voxel<T>(brick, i + dy + dx);
-  const float v001 = load_voxel<T>(brick, i + dz), v101 = load_voxel<T>(brick, i + dz + dx);
-  const float v011 = load_voxel<T>(brick, i + dz + dy);
-  const float v111 = load_voxel<T>(brick, i + dz + dy + dx);
-  const float c00 = v000 + fx * (v100 - v000);
-  const float c10 = v010 + fx * (v110 - v010);
-  const float c01 = v001 + fx * (v101 - v001);
-  const float c11 = v011 + fx * (v111 - v011);
-  const float c0 = c00 + fy * (c10 - c00);
-  const float c1 = c01 + fy * (c11 - c01);
-  return c0 + fz * (c1 - c0);
-}
-
 }  // namespace resoct::cpu::detail
-
-// The kernel's accessors (kernel/traverse.glsl.h) over the context above.
-namespace resoct::kernel {
-
-inline uint resoct_read_node(uint index) {
-  return cpu::detail::g_ctx.nodes[index];
-}
-inline uint resoct_read_page(uint index) {
-  return cpu::detail::g_ctx.pages[index];
-}
-inline uint resoct_read_page_table_offset(uint table) {
-  return cpu::detail::g_ctx.page_offsets[table];
-}
-inline ResoctSlotInfo resoct_read_slot(uint i) {
-  return cpu::detail::g_ctx.slots[i];
-}
-inline ResoctLevelInfo resoct_read_level(uint l) {
-  return cpu::detail::g_ctx.levels[l];
-}
-inline ResoctDepthInfo resoct_read_depth(uint d) {
-  return cpu::detail::g_ctx.depths[d];
-}
-inline vec4 resoct_read_tf(uint slot, uint index) {
-  return cpu::detail::g_ctx.tf[std::size_t(slot) * 1024u + index];
-}
-inline float resoct_read_level_size_log2(uint level) {
-  return cpu::detail::g_ctx.levels[level].size_log2;
-}
-inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
-  const auto& c = cpu::detail::g_ctx;
-  const std::byte* brick = c.cache + std::size_t(cache_slot) * c.slot_voxels * voxel_size(c.type);
-  switch (c.type) {
-    case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.padded, pos);
-    case VoxelType::u16: return cpu::detail::trilinear<std::uint16_t>(brick, c.padded, pos);
-    case VoxelType::f32: return cpu::detail::trilinear<float>(brick, c.padded, pos);
-  }
-  return 0.0f;
-}
-inline void resoct_report_request(uint device_key) {
-  cpu::detail::g_ctx.brick_requests->insert(device_key);
-}
-inline void resoct_report_node_request(uint node) {
-  cpu::detail::g_ctx.node_requests->insert(node);
-}
-inline void resoct_mark_used(uint cache_slot) {
-  std::atomic<std::uint64_t>& w = cpu::detail::g_ctx.used[cache_slot >> 6u];
-  const std::uint64_t bit = std::uint64_t(1) << (cache_slot & 63u);
-  // Read first: almost every call finds the bit set, and a read shares the cache line.
-  if ((w.load(std::memory_order_relaxed) & bit) == 0) w.fetch_or(bit, std::memory_order_relaxed);
-}
-
-}  // namespace resoct::kernel
-
-#include "resoct/kernel/traverse.glsl.h"
 
 namespace resoct::cpu {
 
 namespace {
-
-constexpr std::uint32_t kTile = 16;
 
 template <class T>
 void resize_zeroed(std::vector<T>& v, std::size_t n, const char* what) {
@@ -263,6 +142,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.levels = tables.levels.data();
   c.depths = tables.depths.data();
   c.tf = tables.tf_luts.data();
+  c.fx = &tables.fx;
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;
   c.type = config_.voxel_type;
@@ -275,52 +155,25 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
     result.image = Image(frame.width, frame.height);
   }
   glm::vec4* pixels = result.image.pixels().data();
-  const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
-  const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
-  const std::int64_t tile_count = std::int64_t(tiles_x) * tiles_y;
-
-  std::uint64_t samples = 0, nodes = 0, accesses = 0, iterations = 0, caps = 0, requests = 0;
-  double skipped = 0.0, marched = 0.0;
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
-  // Row-major tile order with dynamic scheduling: neighbouring tiles (coherent rays) run close
-  // in time, and uneven tiles (empty vs. dense) balance.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) \
-    reduction(+ : samples, nodes, accesses, iterations, caps, requests, skipped, marched)
-  for (std::int64_t tile = 0; tile < tile_count; ++tile) {
-    const std::uint32_t tx = std::uint32_t(tile % tiles_x) * kTile;
-    const std::uint32_t ty = std::uint32_t(tile / tiles_x) * kTile;
-    const std::uint32_t x1 = std::min(tx + kTile, frame.width);
-    const std::uint32_t y1 = std::min(ty + kTile, frame.height);
-    for (std::uint32_t y = ty; y < y1; ++y) {
-      for (std::uint32_t x = tx; x < x1; ++x) {
-        kernel::ResoctRayStats st{};
-        const glm::vec4 p = kernel::resoct_render_pixel(frame, x, y, st);
-        // The image holds straight alpha (docs/rendering.md "Compositing").
-        pixels[std::size_t(y) * frame.width + x] =
-            p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
-        samples += st.samples;
-        nodes += st.nodes;
-        accesses += st.brick_accesses;
-        iterations += st.iterations;
-        caps += st.cap_hits;
-        requests += st.requests;
-        skipped += double(st.skipped);
-        marched += double(st.marched);
-      }
-    }
-  }
+  // The effect mask picks the kernel specialization once per frame.
+  const std::uint32_t mask = tables.fx.effects & kernel::RESOCT_EFFECT_ANY;
+  const detail::RayTotals r = mask == 0u ? detail::render_plain(frame, pixels, threads)
+                                         : detail::render_effects(mask, frame, pixels, threads);
 
   BackendStats& s = result.stats;
   s = BackendStats{};
   s.rays = std::uint64_t(frame.width) * frame.height;
-  s.samples = samples;
-  s.nodes_visited = nodes;
-  s.brick_accesses = accesses;
-  s.iterations = iterations;
-  s.cap_hits = caps;
-  s.request_inserts = requests;
-  s.distance_skipped = skipped;
-  s.distance_marched = marched;
+  s.samples = r.samples;
+  s.nodes_visited = r.nodes;
+  s.brick_accesses = r.accesses;
+  s.iterations = r.iterations;
+  s.cap_hits = r.caps;
+  s.request_inserts = r.requests;
+  s.gradient_evals = r.gradients;
+  s.shadow_rays = r.shadow_rays;
+  s.distance_skipped = r.skipped;
+  s.distance_marched = r.marched;
 
   const std::uint32_t level_count = frame.level_count;
   RequestBatch bricks = brick_requests_->drain([level_count](std::uint32_t key) {

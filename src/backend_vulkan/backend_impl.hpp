@@ -68,7 +68,7 @@ struct PushConstants {
 
 constexpr std::uint32_t kWorkgroup = 8;
 constexpr std::uint32_t kMaxProbes = 16;  // RequestSet's default, which the CPU backend uses
-constexpr std::uint32_t kStatWords = 20;
+constexpr std::uint32_t kStatWords = 24;
 constexpr double kDistanceScale = 1048576.0;  // shaders/render.comp DISTANCE_SCALE
 constexpr std::uint64_t kFenceTimeoutNs = 120ull * 1000 * 1000 * 1000;
 // Staging ring size: the frame loop's brick budget plus room for deltas and tables, within

@@ -137,7 +137,9 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
          "transfer functions");
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   begin_batch();
+  // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
   stage_copy(buf[b_frame].buffer, 0, std::as_bytes(std::span(&frame, 1)));
+  stage_copy(buf[b_frame].buffer, sizeof(frame), std::as_bytes(std::span(&tables.fx, 1)));
   stage_copy(buf[b_slots].buffer, 0, std::as_bytes(std::span(tables.slots)));
   stage_copy(buf[b_levels].buffer, 0, std::as_bytes(std::span(tables.levels)));
   stage_copy(buf[b_depths].buffer, 0, std::as_bytes(std::span(tables.depths)));

@@ -37,8 +37,10 @@ struct RenderVariant {
   std::uint32_t cache_chunks = 1;  ///< cache buffers in use (1..8)
   std::uint32_t workgroup_x = 8;   ///< local_size_x_id / local_size_y_id
   std::uint32_t workgroup_y = 8;
+  /// Effect mask RESOCT_EFFECTS (kernel/effects.glsl.h): one pipeline per effect set in use.
+  std::uint32_t effects = 0;
 
-  static constexpr std::array<std::uint32_t, 7> constant_ids = {0, 1, 2, 3, 4, 10, 11};
+  static constexpr std::array<std::uint32_t, 8> constant_ids = {0, 1, 2, 3, 4, 10, 11, 30};
   friend auto operator<=>(const RenderVariant&, const RenderVariant&) = default;
 };
 

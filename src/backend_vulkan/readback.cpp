@@ -96,6 +96,8 @@ void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
   s.requests_dropped = stat(12) + stat(14);
   s.distance_skipped = double(stat(16)) / kDistanceScale;
   s.distance_marched = double(stat(18)) / kDistanceScale;
+  s.gradient_evals = stat(20);
+  s.shadow_rays = stat(22);
   s.ms_device = timer->ms();
 
   drain(reinterpret_cast<const std::uint32_t*>(base + l.brick_requests), brick_capacity,

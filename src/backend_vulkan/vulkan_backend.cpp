@@ -12,6 +12,7 @@
 
 #include "backend_impl.hpp"
 #include "resoct/error.hpp"
+#include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::vk {
@@ -155,7 +156,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
   for (std::size_t i = 0; i < sizes.size(); ++i)
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");
-  m.ensure(b_frame, sizeof(kernel::ResoctFrame), "frame constants");
+  // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
+  m.ensure(b_frame, sizeof(kernel::ResoctFrame) + sizeof(kernel::ResoctFxFrame), "frame constants");
   m.ring.create(*m.ctx, ring_bytes);
   m.ensure_readback(readback_bytes);
   m.scatter->bind(ScatterTarget::pages, m.ring.buffer(), m.ring.capacity(), m.buf[b_pages].buffer,
@@ -173,7 +175,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.configured = true;
 }
 
-RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& /*tables*/) const {
+RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& tables) const {
   RenderVariant v;
   v.voxel_type = std::uint32_t(config.voxel_type);
   v.padded_x = config.padded_brick.x;
@@ -182,6 +184,7 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& /*tables*/)
   v.cache_chunks = chunks;
   v.workgroup_x = kWorkgroup;
   v.workgroup_y = kWorkgroup;
+  v.effects = tables.fx.effects & kernel::RESOCT_EFFECT_ANY;
   return v;
 }
 

@@ -1,6 +1,7 @@
 #include "resoct/frame_tables.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -10,6 +11,8 @@
 
 #include "resoct/camera.hpp"
 #include "resoct/error.hpp"
+#include "resoct/kernel/effects.glsl.h"
+#include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/residency_octree.hpp"
 #include "frame_tables_slices.hpp"
 
@@ -72,6 +75,84 @@ void fill_camera(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFram
   f.voxels_per_box_y = float(per_box.y);
   f.voxels_per_box_z = float(per_box.z);
 }
+
+// --- Effects (kernel/effects.glsl.h) ------------------------------------------------------------
+
+std::uint32_t effect_mask(const Scene& scene) {
+  std::uint32_t m = 0;
+  if (scene.has_effect(Effect::shading)) m |= kernel::RESOCT_EFFECT_SHADING;
+  if (scene.has_effect(Effect::shadows)) m |= kernel::RESOCT_EFFECT_SHADOWS;
+  for (const ChannelSettings& c : scene.channels) {
+    if (c.mode == ChannelMode::iso) m |= kernel::RESOCT_EFFECT_ISO;
+    if (c.mode == ChannelMode::mip || c.mode == ChannelMode::aip) {
+      m |= kernel::RESOCT_EFFECT_PROJECTION;
+    }
+  }
+  return m;
+}
+
+void fill_effects(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFxFrame& f) {
+  f.effects = effect_mask(scene);
+  if (scene.needs_gradients() && h.layout().halo == 0) {
+    throw invalid_parameter("scene.effects",
+                            "gradients (shading, isosurfaces) need a store halo of at least 1 "
+                            "voxel (2 avoids neighbour-brick lookups); this store has 0");
+  }
+  const Light& l = scene.light;
+  f.light_kind = l.kind == Light::Kind::directional ? kernel::RESOCT_LIGHT_DIRECTIONAL
+                 : l.kind == Light::Kind::point     ? kernel::RESOCT_LIGHT_POINT
+                                                    : kernel::RESOCT_LIGHT_HEADLIGHT;
+  const glm::dvec3 v = l.kind == Light::Kind::directional ? glm::normalize(l.vector) : l.vector;
+  f.light_x = float(v.x);
+  f.light_y = float(v.y);
+  f.light_z = float(v.z);
+  f.ambient = float(l.ambient);
+  f.diffuse = float(l.diffuse);
+  f.specular = float(l.specular);
+  f.shininess = float(l.shininess);
+  f.gradient_forward = scene.gradient == GradientStencil::forward ? 1u : 0u;
+  f.shadow_lod_shift = std::uint32_t(std::countr_zero(scene.shadow_lod_factor));
+}
+
+// The slot's mode, isovalues and the visible range the node culling tests (projection.glsl.h).
+void fill_slot_effects(const ChannelSettings& c, kernel::ResoctSlotInfo& s) {
+  s.mode = c.mode == ChannelMode::iso   ? kernel::RESOCT_CHANNEL_ISO
+           : c.mode == ChannelMode::mip ? kernel::RESOCT_CHANNEL_MIP
+           : c.mode == ChannelMode::aip ? kernel::RESOCT_CHANNEL_AIP
+                                        : kernel::RESOCT_CHANNEL_DVR;
+  s.iso_count = std::uint32_t(std::min(c.isovalues.size(), kMaxIsovalues));
+  float iso[kMaxIsovalues] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (std::uint32_t k = 0; k < s.iso_count; ++k) iso[k] = float(c.isovalues[k]);
+  s.iso0 = iso[0];
+  s.iso1 = iso[1];
+  s.iso2 = iso[2];
+  s.iso3 = iso[3];
+  const ValueRange unit{0.0, 1.0};
+  if (c.mode == ChannelMode::iso) {
+    // A node may hold a crossing exactly when its [min, max] reaches an isovalue; occupancy
+    // bins cannot tell (a crossing between two voxel values lies in a bin no voxel occupies).
+    double lo = 1.0, hi = 0.0;
+    bool visible = false;
+    for (double x : c.isovalues) {
+      if (c.tf.evaluate(x).a > 0.0) {
+        visible = true;
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+    }
+    s.vis_bins = visible ? 0xFFFFFFFFu : 0u;
+    s.vis_lo16 = visible ? octree_quantize_min(lo, unit) : 1u;
+    s.vis_hi16 = visible ? octree_quantize_max(hi, unit) : 0u;
+  } else if (c.mode != ChannelMode::dvr) {
+    // Projections: every value may become the result; their nodes are classified by value.
+    const bool visible = !c.tf.fully_transparent();
+    s.vis_bins = visible ? 0xFFFFFFFFu : 0u;
+    s.vis_lo16 = visible ? 0u : 1u;
+    s.vis_hi16 = visible ? kernel::RESOCT_QUANT_MAX : 0u;
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
 
 std::uint32_t check_extent(std::uint64_t v, const char* name) {
   if (v == 0 || v >= kMaxDeviceExtent) {
@@ -139,6 +220,8 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   f.node_slot_count = channels.slot_count();
   f.request_greedy = options.request_strategy == RequestStrategy::greedy ? 1u : 0u;
   fill_camera(scene, hierarchy, f);
+  out.fx = kernel::ResoctFxFrame{};
+  fill_effects(scene, hierarchy, out.fx);
 
   f.extent_x = check_extent(volume.extent.x, "extent");
   f.extent_y = check_extent(volume.extent.y, "extent");
@@ -196,6 +279,7 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     const ValueRange r = volume.range(c.channel);
     s.range_lo = float(r.lo);
     s.inv_range_width = float(1.0 / (r.hi - r.lo));
+    fill_slot_effects(c, s);
     out.slots.push_back(s);
 
     const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);

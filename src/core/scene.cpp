@@ -151,9 +151,145 @@ TransferFunction read_tf(const Reader& r, const json& j, const std::string& path
   return TransferFunction(std::move(points));
 }
 
+json vec_json(const double* v, int n);
+
+// --- Effects: channel modes, isovalues, light, gradient stencil, shadow LOD -------------------
+
+void read_channel_effects(const Reader& r, const json& j, const std::string& path,
+                          ChannelSettings& c) {
+  if (const json* mode = r.find(j, "mode")) {
+    const std::string mp = Reader::join(path, "mode");
+    const std::string m = r.string(*mode, mp);
+    if (m == "dvr") {
+      c.mode = ChannelMode::dvr;
+    } else if (m == "iso") {
+      c.mode = ChannelMode::iso;
+    } else if (m == "mip") {
+      c.mode = ChannelMode::mip;
+    } else if (m == "aip") {
+      c.mode = ChannelMode::aip;
+    } else {
+      r.fail(mp, "'" + m + "' is not a mode (\"dvr\", \"iso\", \"mip\", \"aip\")");
+    }
+  }
+  if (const json* iso = r.find(j, "isovalues")) {
+    const std::string ip = Reader::join(path, "isovalues");
+    r.array(*iso, ip);
+    for (std::size_t i = 0; i < iso->size(); ++i) {
+      c.isovalues.push_back(r.number((*iso)[i], Reader::index(ip, i)));
+    }
+  }
+}
+
+Light read_light(const Reader& r, const json& j) {
+  r.object(j, "light");
+  r.only_keys(j, "light", {"direction", "position", "ambient", "diffuse", "specular", "shininess"});
+  Light l;
+  const json* dir = r.find(j, "direction");
+  const json* pos = r.find(j, "position");
+  if (dir != nullptr && pos != nullptr) r.fail("light", "give a direction or a position, not both");
+  if (dir != nullptr) {
+    l.kind = Light::Kind::directional;
+    l.vector = r.vector<3>(*dir, "light.direction");
+  } else if (pos != nullptr) {
+    l.kind = Light::Kind::point;
+    l.vector = r.vector<3>(*pos, "light.position");
+  }
+  if (const json* v = r.find(j, "ambient")) l.ambient = r.number(*v, "light.ambient");
+  if (const json* v = r.find(j, "diffuse")) l.diffuse = r.number(*v, "light.diffuse");
+  if (const json* v = r.find(j, "specular")) l.specular = r.number(*v, "light.specular");
+  if (const json* v = r.find(j, "shininess")) l.shininess = r.number(*v, "light.shininess");
+  return l;
+}
+
+void read_effect_options(const Reader& r, const json& doc, Scene& s) {
+  if (const json* v = r.find(doc, "light")) s.light = read_light(r, *v);
+  if (const json* v = r.find(doc, "gradient")) {
+    const std::string g = r.string(*v, "gradient");
+    if (g == "central") {
+      s.gradient = GradientStencil::central;
+    } else if (g == "forward") {
+      s.gradient = GradientStencil::forward;
+    } else {
+      r.fail("gradient", "'" + g + "' is not \"central\" or \"forward\"");
+    }
+  }
+  if (const json* v = r.find(doc, "shadow_lod_factor")) {
+    const std::int64_t f = r.integer(*v, "shadow_lod_factor");
+    if (f < 1 || f > 16 || (f & (f - 1)) != 0) {
+      r.fail("shadow_lod_factor", std::to_string(f) + " is not a power of two in 1..16");
+    }
+    s.shadow_lod_factor = std::uint32_t(f);
+  }
+}
+
+template <class Fail>
+void check_effects(const Scene& s, const Fail& fail) {
+  for (std::size_t i = 0; i < s.channels.size(); ++i) {
+    const ChannelSettings& c = s.channels[i];
+    const std::string p = "channels[" + std::to_string(i) + "]";
+    if (c.mode == ChannelMode::iso) {
+      if (c.isovalues.empty() || c.isovalues.size() > kMaxIsovalues) {
+        fail(p + ".isovalues",
+             "mode \"iso\" needs 1.." + std::to_string(kMaxIsovalues) + " isovalues");
+      }
+      for (std::size_t k = 0; k < c.isovalues.size(); ++k) {
+        if (!(c.isovalues[k] >= 0.0 && c.isovalues[k] <= 1.0)) {
+          fail(p + ".isovalues[" + std::to_string(k) + "]",
+               fmt(c.isovalues[k]) + " outside the normalized range [0,1]");
+        }
+      }
+    } else if (!c.isovalues.empty()) {
+      fail(p + ".isovalues", std::string("only channels of mode \"iso\" take isovalues, not \"") +
+                                 to_string(c.mode) + "\"");
+    }
+  }
+  const Light& l = s.light;
+  const bool finite =
+      std::isfinite(l.vector.x) && std::isfinite(l.vector.y) && std::isfinite(l.vector.z);
+  if (!finite) fail("light", "must be finite");
+  if (l.kind == Light::Kind::directional && l.vector == glm::dvec3(0.0)) {
+    fail("light.direction", "must not be zero");
+  }
+  const double coef[3] = {l.ambient, l.diffuse, l.specular};
+  const char* names[3] = {"light.ambient", "light.diffuse", "light.specular"};
+  for (int k = 0; k < 3; ++k) {
+    if (!(coef[k] >= 0.0 && coef[k] <= 10.0)) fail(names[k], fmt(coef[k]) + " outside [0, 10]");
+  }
+  if (!(l.shininess >= 1.0 && l.shininess <= 1024.0)) {
+    fail("light.shininess", fmt(l.shininess) + " outside [1, 1024]");
+  }
+  const std::uint32_t f = s.shadow_lod_factor;
+  if (f < 1 || f > 16 || (f & (f - 1)) != 0) {
+    fail("shadow_lod_factor", std::to_string(f) + " is not a power of two in 1..16");
+  }
+  if (s.has_effect(Effect::shadows) && !s.has_effect(Effect::shading)) {
+    bool iso = false;
+    for (const ChannelSettings& c : s.channels) iso = iso || c.mode == ChannelMode::iso;
+    if (!iso) {
+      fail("effects", "\"shadows\" darkens shaded samples: it needs \"shading\" or an iso channel");
+    }
+  }
+}
+
+void effects_to_json(const Scene& s, json& doc) {
+  json light;
+  if (s.light.kind == Light::Kind::directional) light["direction"] = vec_json(&s.light.vector.x, 3);
+  if (s.light.kind == Light::Kind::point) light["position"] = vec_json(&s.light.vector.x, 3);
+  light["ambient"] = s.light.ambient;
+  light["diffuse"] = s.light.diffuse;
+  light["specular"] = s.light.specular;
+  light["shininess"] = s.light.shininess;
+  doc["light"] = light;
+  doc["gradient"] = s.gradient == GradientStencil::forward ? "forward" : "central";
+  doc["shadow_lod_factor"] = s.shadow_lod_factor;
+}
+
+// ------------------------------------------------------------------------------------------------
+
 ChannelSettings read_channel(const Reader& r, const json& j, const std::string& path) {
   r.object(j, path);
-  r.only_keys(j, path, {"channel", "tf", "levels", "importance", "mode"});
+  r.only_keys(j, path, {"channel", "tf", "levels", "importance", "mode", "isovalues"});
   ChannelSettings c;
   const std::string channel_path = Reader::join(path, "channel");
   const std::int64_t channel = r.integer(r.require(j, path, "channel"), channel_path);
@@ -180,11 +316,7 @@ ChannelSettings read_channel(const Reader& r, const json& j, const std::string& 
     if (v < INT32_MIN || v > INT32_MAX) r.fail(ip, "out of range");
     c.importance = std::int32_t(v);
   }
-  if (const json* mode = r.find(j, "mode")) {
-    const std::string mp = Reader::join(path, "mode");
-    const std::string m = r.string(*mode, mp);
-    if (m != "dvr") r.fail(mp, "'" + m + "' is not a supported mode (\"dvr\")");
-  }
+  read_channel_effects(r, j, path, c);
   return c;
 }
 
@@ -256,6 +388,7 @@ void check_scene(const Scene& s, const std::string& what) {
     }
   }
   detail::check_slices_and_lens(s, what);
+  check_effects(s, fail);
 }
 
 json vec_json(const double* v, int n) {
@@ -268,6 +401,31 @@ json vec_json(const double* v, int n) {
 
 const char* to_string(Effect e) noexcept {
   return e == Effect::shadows ? "shadows" : "shading";
+}
+
+const char* to_string(ChannelMode m) noexcept {
+  switch (m) {
+    case ChannelMode::iso: return "iso";
+    case ChannelMode::mip: return "mip";
+    case ChannelMode::aip: return "aip";
+    case ChannelMode::dvr: break;
+  }
+  return "dvr";
+}
+
+bool Scene::has_effect(Effect e) const noexcept {
+  for (Effect x : effects) {
+    if (x == e) return true;
+  }
+  return false;
+}
+
+bool Scene::needs_gradients() const noexcept {
+  if (has_effect(Effect::shading)) return true;
+  for (const ChannelSettings& c : channels) {
+    if (c.mode == ChannelMode::iso) return true;
+  }
+  return false;
 }
 
 void Scene::validate(const std::string& what) const {
@@ -299,9 +457,10 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   }
   const Reader r(name);
   if (!doc.is_object()) r.fail("(root)", "must be an object");
-  r.only_keys(doc, "",
-              {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity",
-               "background", "effects", "slices", "lens"});
+  r.only_keys(
+      doc, "",
+      {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity", "background",
+       "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor"});
   Scene s;
   s.camera = read_camera(r, r.require(doc, "", "camera"));
   if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
@@ -328,6 +487,7 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
     }
   }
   detail::read_slices_and_lens(doc, name, s);
+  read_effect_options(r, doc, s);
   check_scene(s, name);
   return s;
 }
@@ -362,7 +522,8 @@ std::string scene_to_json(const Scene& s) {
                         {"tf", tf},
                         {"levels", {c.finest_level, c.coarsest_level}},
                         {"importance", c.importance},
-                        {"mode", "dvr"}});
+                        {"mode", to_string(c.mode)}});
+    if (c.mode == ChannelMode::iso) channels.back()["isovalues"] = c.isovalues;
   }
   doc["channels"] = channels;
   doc["step_scale"] = s.step_scale;
@@ -373,6 +534,7 @@ std::string scene_to_json(const Scene& s) {
   for (Effect e : s.effects) effects.push_back(to_string(e));
   doc["effects"] = effects;
   detail::slices_and_lens_to_json(s, doc);
+  effects_to_json(s, doc);
   return doc.dump(2) + "\n";
 }
 

@@ -9,6 +9,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, binding = 0) readonly buffer Frame {
   ResoctFrame frame;
+  ResoctFxFrame fx_frame;
 };
 layout(std430, binding = 1) readonly buffer Slots {
   ResoctSlotInfo slots[];
@@ -73,6 +74,9 @@ ResoctDepthInfo resoct_read_depth(uint d) {
 }
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];
+}
+ResoctFxFrame resoct_read_fx_frame() {
+  return fx_frame;
 }
 float resoct_read_level_size_log2(uint level) {
   return levels[level].size_log2;

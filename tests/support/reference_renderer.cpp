@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 
 #include "resoct/error.hpp"
 
@@ -74,6 +76,64 @@ glm::dvec2 reference_ray_box(const Ray& ray, const glm::dvec3& lo, const glm::dv
   return {enter, exit};
 }
 
+namespace {
+
+double normalized(const VolumeDesc& v, const VoxelFunction& voxels, std::uint32_t c,
+                  const glm::dvec3& pos) {
+  const ValueRange r = v.range(c);
+  return (sample_trilinear(voxels, c, v.extent, pos) - r.lo) / (r.hi - r.lo);
+}
+
+// Clamps a level-0 position into [0, extent) like the kernel's sample positions.
+glm::dvec3 clamp_position(const VolumeDesc& v, glm::dvec3 p) {
+  for (int a = 0; a < 3; ++a) p[a] = std::clamp(p[a], 0.0, double(v.extent[a]) - 1e-7);
+  return p;
+}
+
+}  // namespace
+
+glm::dvec3 reference_gradient(const VolumeDesc& volume, const VoxelFunction& voxels,
+                              std::uint32_t channel, const glm::dvec3& pos, bool forward) {
+  const glm::dvec3 h = box_voxel_size(volume);
+  glm::dvec3 g(0.0);
+  const double f0 = normalized(volume, voxels, channel, pos);
+  for (int a = 0; a < 3; ++a) {
+    glm::dvec3 e(0.0);
+    e[a] = 1.0;
+    const double fp = normalized(volume, voxels, channel, clamp_position(volume, pos + e));
+    if (forward) {
+      g[a] = (fp - f0) / h[a];
+    } else {
+      const double fm = normalized(volume, voxels, channel, clamp_position(volume, pos - e));
+      g[a] = (fp - fm) / (2.0 * h[a]);
+    }
+  }
+  return g;
+}
+
+glm::dvec3 reference_shade(const Scene& scene, const glm::dvec3& rgb, const glm::dvec3& gradient,
+                           const glm::dvec3& pos_box, const glm::dvec3& view_dir) {
+  const double g2 = glm::dot(gradient, gradient);
+  if (!(g2 > 0.0)) return rgb;
+  const Light& l = scene.light;
+  glm::dvec3 light = -view_dir;
+  if (l.kind == Light::Kind::directional) light = -glm::normalize(l.vector);
+  if (l.kind == Light::Kind::point && glm::length(l.vector - pos_box) > 0.0) {
+    light = glm::normalize(l.vector - pos_box);
+  }
+  glm::dvec3 n = -gradient / std::sqrt(g2);
+  const glm::dvec3 v = -view_dir;
+  if (glm::dot(n, v) < 0.0) n = -n;
+  const double ndl = std::max(glm::dot(n, light), 0.0);
+  const glm::dvec3 hv = light + v;
+  double spec = 0.0;
+  if (glm::length(hv) > 0.0 && ndl > 0.0) {
+    spec = std::pow(std::max(glm::dot(n, glm::normalize(hv)), 0.0), l.shininess);
+  }
+  return glm::clamp(rgb * (l.ambient + l.diffuse * ndl) + glm::dvec3(l.specular * spec),
+                    glm::dvec3(0.0), glm::dvec3(1.0));
+}
+
 glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const VoxelFunction& voxels,
                          const Ray& ray, const ReferenceOptions& options) {
   if (!(options.step > 0.0)) throw invalid_parameter("step", "must be positive");
@@ -87,24 +147,79 @@ glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const Vox
   const double delta0 = reference_step(volume);
   const double step = options.step * delta0;
   const glm::dvec3 to_voxels = glm::dvec3(volume.extent) / box;
+  const bool shading = scene.has_effect(Effect::shading);
+  const bool forward = scene.gradient == GradientStencil::forward;
+  const std::size_t n = scene.channels.size();
+  std::vector<double> proj(n, 0.0), prev_v(n, 0.0), prev_t(n, 0.0);
+  std::vector<bool> have_prev(n, false);
+  auto position = [&](double t) { return (ray.origin + ray.dir * t) * to_voxels; };
   const auto segments = std::uint64_t(std::ceil((t_exit - t_enter) / step));
   for (std::uint64_t k = 0; k < segments; ++k) {
     const double t0 = t_enter + double(k) * step;
     const double t1 = std::min(t0 + step, t_exit);
     if (!(t1 > t0)) break;
-    const glm::dvec3 pos = (ray.origin + ray.dir * (0.5 * (t0 + t1))) * to_voxels;
+    const double tm = 0.5 * (t0 + t1);
+    const glm::dvec3 pos = position(tm);
     // Intermixing: α = 1 − Π(1 − α'_c), colour weighted by α'_c (docs/rendering.md).
     double transmit = 1.0;
     double weight = 0.0;
     glm::dvec3 weighted(0.0);
-    for (const ChannelSettings& c : scene.channels) {
-      const ValueRange range = volume.range(c.channel);
-      const double raw = sample_trilinear(voxels, c.channel, volume.extent, pos);
-      const glm::dvec4 rgba = c.tf.evaluate((raw - range.lo) / (range.hi - range.lo));
+    for (std::size_t ci = 0; ci < n; ++ci) {
+      const ChannelSettings& c = scene.channels[ci];
+      const double x = normalized(volume, voxels, c.channel, pos);
+      if (c.mode == ChannelMode::mip) {
+        proj[ci] = std::max(proj[ci], std::clamp(x, 0.0, 1.0));
+        continue;
+      }
+      if (c.mode == ChannelMode::aip) {
+        proj[ci] += std::clamp(x, 0.0, 1.0) * (t1 - t0);
+        continue;
+      }
+      if (c.mode == ChannelMode::iso) {
+        const double pv = prev_v[ci];
+        double iso = 0.0;
+        bool crossed = false;
+        for (double v : c.isovalues) {
+          if (have_prev[ci] && (pv < v) != (x < v) &&
+              (!crossed || std::abs(v - pv) < std::abs(iso - pv))) {
+            iso = v;
+            crossed = true;
+          }
+        }
+        if (crossed) {
+          double a = prev_t[ci], b = tm;
+          const bool below = pv < iso;
+          for (int i = 0; i < 60; ++i) {
+            const double m = 0.5 * (a + b);
+            const bool mb = normalized(volume, voxels, c.channel, position(m)) < iso;
+            (mb == below ? a : b) = m;
+          }
+          const double th = 0.5 * (a + b);
+          const glm::dvec4 rgba = c.tf.evaluate(iso);
+          const glm::dvec3 hit = clamp_position(volume, position(th));
+          const glm::dvec3 lit = reference_shade(
+              scene, glm::dvec3(rgba), reference_gradient(volume, voxels, c.channel, hit, forward),
+              ray.origin + ray.dir * th, ray.dir);
+          const double sa = std::min(rgba.a, 1.0);
+          acc += (1.0 - acc.a) * glm::dvec4(lit * sa, sa);
+        }
+        prev_v[ci] = x;
+        prev_t[ci] = tm;
+        have_prev[ci] = true;
+        continue;
+      }
+      const glm::dvec4 rgba = c.tf.evaluate(x);
       const double a = rgba.a >= 1.0 ? 1.0 : -std::expm1((t1 - t0) / delta0 * std::log1p(-rgba.a));
+      glm::dvec3 rgb(rgba);
+      if (shading && a > 0.0) {
+        rgb = reference_shade(
+            scene, rgb,
+            reference_gradient(volume, voxels, c.channel, clamp_position(volume, pos), forward),
+            ray.origin + ray.dir * tm, ray.dir);
+      }
       transmit *= 1.0 - a;
       weight += a;
-      weighted += a * glm::dvec3(rgba);
+      weighted += a * rgb;
     }
     const double alpha = 1.0 - transmit;
     if (weight > 0.0) {
@@ -113,6 +228,21 @@ glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const Vox
     }
     if (options.early_termination && acc.a >= scene.ert_opacity) break;
   }
+  // Projections: through their TF, intermixed like one sample, behind the accumulated colour.
+  double transmit = 1.0, weight = 0.0;
+  glm::dvec3 weighted(0.0);
+  for (std::size_t ci = 0; ci < n; ++ci) {
+    const ChannelSettings& c = scene.channels[ci];
+    if (c.mode != ChannelMode::mip && c.mode != ChannelMode::aip) continue;
+    const double v = c.mode == ChannelMode::aip ? proj[ci] / (t_exit - t_enter) : proj[ci];
+    const glm::dvec4 rgba = c.tf.evaluate(v);
+    const double a = std::clamp(rgba.a, 0.0, 1.0);
+    transmit *= 1.0 - a;
+    weight += a;
+    weighted += a * glm::dvec3(rgba);
+  }
+  if (weight > 0.0)
+    acc += (1.0 - acc.a) * glm::dvec4(weighted * ((1.0 - transmit) / weight), 1.0 - transmit);
   return acc;
 }
 

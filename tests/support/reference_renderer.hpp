@@ -10,7 +10,12 @@
 //   a shorter last segment, each with its own opacity correction, so a constant medium gives the
 //   closed form 1 − exp(−σL) for any step;
 // - ray/box intersection is written here independently of kernel/ray.glsl.h (same half-open
-//   convention).
+//   convention);
+// - effects (docs/rendering.md "Effects"): "shading" lights DVR samples with the level-0
+//   gradient; iso channels find crossings between consecutive reference samples and bisect the
+//   trilinear field in double (60 halvings), the surface lit with the gradient at the hit; MIP /
+//   AIP project the clamped normalized value and are composited behind. Shadows are not
+//   modelled (tests check them against geometry).
 
 #include <cstdint>
 #include <functional>
@@ -52,6 +57,17 @@ double reference_step(const VolumeDesc& volume);
 /// Half-open slab test in double: (t_enter, t_exit) of the ray with [lo, hi); hit iff enter <
 /// exit.
 glm::dvec2 reference_ray_box(const Ray& ray, const glm::dvec3& lo, const glm::dvec3& hi);
+
+/// Box-space gradient of channel `c`'s normalized level-0 field at `pos` (level-0 voxels):
+/// central (or, with `forward`, forward) differences at ± one voxel of the clamp-to-edge
+/// trilinear field (docs/rendering.md "Effects").
+glm::dvec3 reference_gradient(const VolumeDesc& volume, const VoxelFunction& voxels,
+                              std::uint32_t channel, const glm::dvec3& pos, bool forward = false);
+
+/// Blinn-Phong of docs/rendering.md "Effects" in double, without shadows: straight colour `rgb`
+/// lit with the normal from `gradient`, light from `scene.light` at box position `pos_box`.
+glm::dvec3 reference_shade(const Scene& scene, const glm::dvec3& rgb, const glm::dvec3& gradient,
+                           const glm::dvec3& pos_box, const glm::dvec3& view_dir);
 
 /// Premultiplied RGBA accumulated along one ray (box units, t >= 0), before the background.
 glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const VoxelFunction& voxels,

@@ -99,6 +99,32 @@ TEST(RenderTool, RendersSlicesAndLens) {
   EXPECT_GT(grey, 40u);
 }
 
+// The shipped effect scenes: stats.json counts gradients and shadow rays exactly when the scene
+// declares effects that need them.
+TEST(RenderTool, EffectScenesReportGradientsAndShadowRays) {
+  TempDir dir;
+  struct Case {
+    const char* volume;
+    const char* scene;
+    bool gradients;
+    bool shadows;
+  };
+  for (const Case& c : {Case{"procedural:sphere:48x48x48", "sphere_iso", true, true},
+                        Case{"procedural:tubes:48x48x48", "tubes_shaded", true, true},
+                        Case{"procedural:tubes:48x48x48", "tubes_mip", false, false},
+                        Case{"procedural:tubes:48x48x48", "tubes", false, false}}) {
+    const std::string png = dir.file(std::string(c.scene) + ".png");
+    const std::string stats = dir.file(std::string(c.scene) + ".json");
+    const ToolRun r = run(dir, RESOCT_RENDER, render_args(c.volume, scene(c.scene), png, stats));
+    ASSERT_EQ(r.exit_code, 0) << c.scene << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+    EXPECT_TRUE(j["converged"].get<bool>()) << c.scene;
+    EXPECT_EQ(j["gradient_evals"].get<std::uint64_t>() > 0, c.gradients) << c.scene;
+    EXPECT_EQ(j["shadow_rays"].get<std::uint64_t>() > 0, c.shadows) << c.scene;
+    EXPECT_EQ(j["cap_hits"].get<std::uint64_t>(), 0u) << c.scene;
+  }
+}
+
 TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
   TempDir dir;
   const std::string png = dir.file("x.png"), stats = dir.file("x.json");

@@ -130,6 +130,24 @@ struct ResoctFrame {
   float lens_matrix[9];
 };
 
+// Effect constants of a frame (kernel/effects.glsl.h; docs/rendering.md "Effects"), a record of
+// their own: ResoctFrame is passed by value to many helpers of the plain kernel, and growing it
+// changes how the C++ compiler inlines them. Read through resoct_read_fx_frame() only by the
+// kernel specializations that use effects.
+struct ResoctFxFrame {
+  uint effects;     // RESOCT_EFFECT_* bits these tables were built for
+  uint light_kind;  // RESOCT_LIGHT_*
+  float light_x;    // directional: direction the light travels; point: position (box)
+  float light_y;
+  float light_z;
+  float ambient;  // Blinn-Phong coefficients
+  float diffuse;
+  float specular;
+  float shininess;
+  uint gradient_forward;  // 1: forward differences (3 lookups), 0: central (6 lookups)
+  uint shadow_lod_shift;  // shadow rays march the view LOD level + this (paper 004 §7.2)
+};
+
 // One visible channel, in importance order (slot table index 0 is traversed first).
 struct ResoctSlotInfo {
   uint slot;          // page-table / octree slot this channel occupies
@@ -140,6 +158,13 @@ struct ResoctSlotInfo {
   uint vis_hi16;   //   lo rounded down, hi rounded up; vis_lo16 > vis_hi16 = never visible
   float range_lo;  // raw voxel value -> normalized: (raw - range_lo) * inv_range_width
   float inv_range_width;
+  // Effects: RESOCT_CHANNEL_* mode and up to RESOCT_MAX_ISOVALUES normalized isovalues (iso).
+  uint mode;
+  uint iso_count;
+  float iso0;
+  float iso1;
+  float iso2;
+  float iso3;
 };
 
 // One brick-hierarchy level.
@@ -184,6 +209,8 @@ struct ResoctRayStats {
   uint requests;        // request inserts attempted
   float skipped;        // box-space distance skipped as empty
   float marched;        // box-space distance marched inside the volume
+  uint gradient_evals;  // gradients computed (shading, isosurface normals)
+  uint shadow_rays;     // shadow rays cast
 };
 
 RESOCT_KERNEL_END

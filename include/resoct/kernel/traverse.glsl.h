@@ -17,6 +17,7 @@
 //   void  resoct_mark_used(uint cache_slot)          the slot was sampled this frame
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
+//   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
 //
 // Per ray: the camera ray is clipped to the volume [0, extent) in voxel space relative to the
 // exact eye cell; t (box units) runs over segments of length dt (Eq. 8.2-8.3), each sampled at
@@ -32,9 +33,13 @@
 #include "resoct/kernel/channel_sample.glsl.h"
 #include "resoct/kernel/common.glsl.h"
 #include "resoct/kernel/composite.glsl.h"
+#include "resoct/kernel/effect_sample.glsl.h"
+#include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
+#include "resoct/kernel/node_class.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/projection.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 #include "resoct/kernel/sample.glsl.h"
@@ -43,14 +48,6 @@
 #include "resoct/kernel/tf.glsl.h"
 
 RESOCT_KERNEL_BEGIN
-
-// Node classification of one channel.
-RESOCT_CONST(uint, RESOCT_NODE_CLASS_VISIBLE, 0u);
-RESOCT_CONST(uint, RESOCT_NODE_CLASS_INVALID, 1u);
-RESOCT_CONST(uint, RESOCT_NODE_CLASS_EMPTY, 2u);
-RESOCT_CONST(uint, RESOCT_NODE_CLASS_HOMOGENEOUS, 3u);
-
-RESOCT_CONST(uint, RESOCT_NONE_U, 0xFFFFFFFFu);
 
 RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.samples = 0u;
@@ -61,107 +58,15 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.requests = 0u;
   st.skipped = 0.0f;
   st.marched = 0.0f;
+  st.gradient_evals = 0u;
+  st.shadow_rays = 0u;
 }
 
-/// Child bits of a node coordinate at depth D: the low coordinate bit of each split axis, z then
-/// y then x with x least significant (OctreeLayout's order).
-RESOCT_FN uint resoct_node_child_bits(ResoctDepthInfo D, uvec3 c) {
-  uint bits = 0u;
-  uint shift = 0u;
-  if (D.split_x != 0u) {
-    bits = c.x & 1u;
-    shift = 1u;
-  }
-  if (D.split_y != 0u) {
-    bits = bits | ((c.y & 1u) << shift);
-    shift = shift + 1u;
-  }
-  if (D.split_z != 0u) bits = bits | ((c.z & 1u) << shift);
-  return bits;
-}
-
-/// Coordinates of the node at depth D containing a cell inside the volume.
-RESOCT_FN uvec3 resoct_node_coord(ResoctDepthInfo D, ivec3 cell) {
-  uvec3 c = uvec3(cell) / uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
-  return min(c, uvec3(D.count_x - 1u, D.count_y - 1u, D.count_z - 1u));
-}
-
-/// Classifies one channel at a node from its own metadata record.
-RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
-  uint base = resoct_node_base(node, s.slot, node_slots);
-  uint flags = resoct_read_node(base + RESOCT_NODE_FLAGS);
-  uint state = resoct_node_state(flags);
-  if (state == RESOCT_NODE_INVALID) return RESOCT_NODE_CLASS_INVALID;
-  uint minmax = resoct_read_node(base + RESOCT_NODE_MINMAX);
-  uint occupancy = resoct_read_node(base + RESOCT_NODE_OCCUPANCY);
-  if (!resoct_node_may_be_visible(minmax, occupancy, s.vis_lo16, s.vis_hi16, s.vis_bins)) {
-    return RESOCT_NODE_CLASS_EMPTY;
-  }
-  if (state == RESOCT_NODE_VALID && resoct_node_min16(minmax) == resoct_node_max16(minmax)) {
-    return RESOCT_NODE_CLASS_HOMOGENEOUS;
-  }
-  return RESOCT_NODE_CLASS_VISIBLE;
-}
-
-/// Deepest octree depth whose nodes are at least one step long on every axis (smaller nodes
-/// cannot skip more than a step), at least the start depth.
-RESOCT_FN uint resoct_traversal_depth(ResoctFrame f, float dt) {
-  uint depth = f.start_depth;
-  for (uint d = f.start_depth + 1u; d < f.depth_count; ++d) {
-    ResoctDepthInfo D = resoct_read_depth(d);
-    float sx = float(D.node_extent_x) / f.voxels_per_box_x;
-    float sy = float(D.node_extent_y) / f.voxels_per_box_y;
-    float sz = float(D.node_extent_z) / f.voxels_per_box_z;
-    if (min(sx, min(sy, sz)) < dt) break;
-    depth = d;
-  }
-  return depth;
-}
-
-/// log2 of the node counts per axis at depth D (counts are powers of two).
-RESOCT_FN uvec3 resoct_depth_count_log2(ResoctDepthInfo D) {
-  return uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
-}
-
-/// Coordinates at depth D of the ancestor of the node with coordinates `deep` at a deeper depth
-/// whose count_log2 is `deep_log2`: node boxes nest exactly, so this is a shift, not a division.
-RESOCT_FN uvec3 resoct_ancestor_coord(ResoctDepthInfo D, uvec3 deep, uvec3 deep_log2) {
-  return deep >> (deep_log2 - resoct_depth_count_log2(D));
-}
-
-/// Flat index of the node at depth `depth` whose coordinates are `coord` (count_log2
-/// `coord_log2`), built from the root by child bits.
-RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
-  uint local = 0u;
-  for (uint d = 1u; d <= depth; ++d) {
-    ResoctDepthInfo D = resoct_read_depth(d);
-    local = (local << D.child_shift) |
-            resoct_node_child_bits(D, resoct_ancestor_coord(D, coord, coord_log2));
-  }
-  return resoct_read_depth(depth).first_node + local;
-}
-
-/// Class of a channel at the node of depth `depth` on the path to (coord, coord_log2): its own
-/// record if it has metadata, else that of the nearest ancestor (down to `top`) that has, since a
-/// parent's record covers its children; INVALID when none has.
-RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
-                                         uvec3 coord_log2, ResoctSlotInfo s, uint node_slots) {
-  uint cls = resoct_node_class(node, s, node_slots);
-  uint d = depth;
-  while (cls == RESOCT_NODE_CLASS_INVALID && d > top) {
-    d = d - 1u;
-    ResoctDepthInfo D = resoct_read_depth(d);
-    cls = resoct_node_class(resoct_node_index(d, resoct_ancestor_coord(D, coord, coord_log2),
-                                              resoct_depth_count_log2(D)),
-                            s, node_slots);
-  }
-  return cls;
-}
-
-/// Renders one pixel: the premultiplied colour over the background. `stats` receives the ray's
-/// counters.
-RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
-                                   RESOCT_OUT(ResoctRayStats) stats) {
+/// Renders one pixel with the effects of RESOCT_EFFECTS (kernel/effects.glsl.h): the
+/// premultiplied colour over the background. `stats` receives the ray's counters. With mask 0
+/// every effect branch is compiled out.
+RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
+                                         RESOCT_OUT(ResoctRayStats) stats) {
   resoct_stats_clear(stats);
   vec4 background = vec4(f.background_r, f.background_g, f.background_b, f.background_a);
   vec4 acc = vec4(0.0f);
@@ -174,6 +79,8 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
     if (resoct_read_slot(i).vis_bins != 0u) live = live | (1u << i);
   }
   if (live == 0u && f.slice_count == 0u) return resoct_over_background(acc, background);
+  // A lens changes `live` per segment; projections report every channel live anywhere.
+  uint live_anywhere = live;
 
   vec3 dir_box;
   ivec3 o_cell;
@@ -206,6 +113,22 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
   uint cached_empty = 0u;
   uint cached_homog = 0u;
   uint cached_skip_depth = RESOCT_NONE_U;
+
+  // Effects: per-ray state and constants (only touched by specializations that use them).
+  ResoctFxRay fx;
+  ResoctFxRayConst rc;
+  ResoctFxParams fxp;
+  RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+    resoct_fx_ray_clear(fx);
+    rc.o_cell = o_cell;
+    rc.o_frac = o_frac;
+    rc.dir_box = dir_box;
+    rc.dir_vox = dir_vox;
+    rc.n = n;
+    rc.live = live;
+    fxp = resoct_fx_params(f, resoct_read_fx_frame());
+  }
+  float t_enter = t;
 
   // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
   // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs
@@ -243,6 +166,11 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
     resoct_mix_begin(weighted, combined);
     bool any_value = false;
     bool skip = false;
+    // Effects: the channels' values are collected and handled by one call below, so the GPU
+    // compiler inlines the effect code once, not once per render mode.
+    float fx_value[RESOCT_MAX_SLOTS];
+    uint fx_level[RESOCT_MAX_SLOTS];
+    uint fx_have = 0u;
     float skip_exit = RESOCT_RAY_T_INF;
 
     if (f.mode == RESOCT_MODE_RESIDENCY) {
@@ -270,10 +198,20 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           uint nd = D.first_node + local;
           stats.nodes = stats.nodes + 1u;
           while (ci < n) {
-            bool empty = ((live >> ci) & 1u) == 0u ||
-                         resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
-                                                   resoct_read_slot(bank + ci),
-                                                   f.node_slot_count) == RESOCT_NODE_CLASS_EMPTY;
+            bool empty = ((live >> ci) & 1u) == 0u;
+            if (!empty) {
+              uint cls;
+              RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                cls = resoct_mode_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                                                     resoct_read_slot(bank + ci), f.node_slot_count,
+                                                     fx.proj[ci]);
+              }
+              else {
+                cls = resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                                                resoct_read_slot(bank + ci), f.node_slot_count);
+              }
+              empty = cls == RESOCT_NODE_CLASS_EMPTY;
+            }
             if (!empty) break;
             cached_empty = cached_empty | (1u << ci);
             ci = ci + 1u;
@@ -294,11 +232,23 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
               continue;
             }
             ResoctSlotInfo sc = resoct_read_slot(bank + c);
-            uint cls = resoct_node_class(node, sc, f.node_slot_count);
+            uint cls;
+            RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+              cls = resoct_mode_node_class(node, sc, f.node_slot_count, fx.proj[c]);
+            }
+            else {
+              cls = resoct_node_class(node, sc, f.node_slot_count);
+            }
             if (cls == RESOCT_NODE_CLASS_INVALID) {
               invalid = true;
-              cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
-                                              trav_log2, sc, f.node_slot_count);
+              RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                cls = resoct_mode_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
+                                                     trav_log2, sc, f.node_slot_count, fx.proj[c]);
+              }
+              else {
+                cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
+                                                trav_log2, sc, f.node_slot_count);
+              }
               // A homogeneous ancestor's value is only known at the ancestor: read it there.
               if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
             }
@@ -326,20 +276,32 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           ResoctSlotInfo s = resoct_read_slot(bank + c);
           float value = 0.0f;
           uint res = RESOCT_CH_NONE;
+          uint target = 0u;
           if (((cached_homog >> c) & 1u) != 0u) {
             uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
                                        RESOCT_NODE_MINMAX);
             value = float(resoct_node_min16(mm)) / 65535.0f;
             res = RESOCT_CH_VALUE;
           } else {
-            uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+            target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
             res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
                                            stats);
           }
           if (res == RESOCT_CH_VALUE) {
-            vec4 rgba = resoct_tf_lookup(s.slot, value);
-            resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
-                           resoct_correct_opacity(rgba.a, seg / f.ref_step));
+            RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+              uint level = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
+                level = resoct_present_level(sp, s, node, level, cell);
+              }
+              fx_value[c] = value;
+              fx_level[c] = level;
+              fx_have = fx_have | (1u << c);
+            }
+            else {
+              vec4 rgba = resoct_tf_lookup(s.slot, value);
+              resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
+                             resoct_correct_opacity(rgba.a, seg / f.ref_step));
+            }
             any_value = true;
           }
         }
@@ -368,13 +330,33 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
           all_empty = false;
         }
         if (res == RESOCT_CH_VALUE) {
-          vec4 rgba = resoct_tf_lookup(s.slot, value);
-          resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
-                         resoct_correct_opacity(rgba.a, seg / f.ref_step));
+          RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+            uint level = target;
+            RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
+              if (f.mode == RESOCT_MODE_OCTREE) level = resoct_octree_level(sp, s, target, cell);
+            }
+            fx_value[c] = value;
+            fx_level[c] = level;
+            fx_have = fx_have | (1u << c);
+          }
+          else {
+            vec4 rgba = resoct_tf_lookup(s.slot, value);
+            resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
+                           resoct_correct_opacity(rgba.a, seg / f.ref_step));
+          }
           any_value = true;
         }
       }
       skip = all_empty;
+    }
+
+    RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+      for (uint c = 0u; c < n; ++c) {
+        if (((fx_have >> c) & 1u) == 0u) continue;
+        RESOCT_FX(resoct_fx_channel)
+        (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], lod, seg, tm, cell,
+         frac, fx, weighted, combined, acc, stats);
+      }
     }
 
     if (any_value) {
@@ -395,7 +377,16 @@ RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
       t = resoct_advance_t(t, seg);
     }
   }
+  RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+    acc = resoct_fx_projection_composite(fx, n, live_anywhere, t_exit - t_enter, acc);
+  }
   return resoct_over_background(acc, background);
+}
+
+/// Renders one pixel without effects (C++), or with the pipeline's RESOCT_EFFECTS (GLSL).
+RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
+                                   RESOCT_OUT(ResoctRayStats) stats) {
+  return RESOCT_FX_PLAIN(resoct_render_pixel_fx)(f, px, py, stats);
 }
 
 RESOCT_KERNEL_END

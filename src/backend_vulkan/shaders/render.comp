@@ -35,6 +35,7 @@ pc;
 
 layout(std430, binding = 0) readonly buffer FrameBuf {
   ResoctFrame frame;
+  ResoctFxFrame fx_frame;  // effect constants, right after the frame (std430: scalars only)
 };
 layout(std430, binding = 1) readonly buffer Slots {
   ResoctSlotInfo slots[];
@@ -112,7 +113,9 @@ const uint STAT_BRICK_DROPPED = 6u;
 const uint STAT_NODE_DROPPED = 7u;
 const uint STAT_SKIPPED = 8u;  // box units * 2^20, rounded per ray
 const uint STAT_MARCHED = 9u;
-const uint STAT_COUNT = 10u;
+const uint STAT_GRADIENTS = 10u;
+const uint STAT_SHADOW_RAYS = 11u;
+const uint STAT_COUNT = 12u;
 const float DISTANCE_SCALE = 1048576.0;
 
 // Requests this invocation could not insert (private per invocation, reduced with the rest).
@@ -162,6 +165,9 @@ ResoctDepthInfo resoct_read_depth(uint d) {
 }
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];
+}
+ResoctFxFrame resoct_read_fx_frame() {
+  return fx_frame;
 }
 float resoct_read_level_size_log2(uint level) {
   return levels[level].size_log2;
@@ -297,7 +303,8 @@ void main() {
   // No early return: every invocation takes part in the reduction's barriers.
   if (px.x < frame.width && px.y < frame.height) {
     ResoctRayStats st;
-    vec4 p = resoct_render_pixel(frame, px.x, px.y, st);
+    // RESOCT_EFFECTS (constant_id 30, kernel/effects.glsl.h) selects the effect specialization.
+    vec4 p = resoct_render_pixel_fx(frame, px.x, px.y, st);
     // lavapipe ends every loop of an invocation once 65535 loop back-edges were taken in total
     // (a driver guard against endless loops), which would cut a long ray short without a trace.
     // This loop's trip count is unknown at compile time, so it stays a loop: it runs twice unless
@@ -317,6 +324,8 @@ void main() {
     counts[STAT_NODE_DROPPED] = g_node_dropped;
     counts[STAT_SKIPPED] = uint(round(st.skipped * DISTANCE_SCALE));
     counts[STAT_MARCHED] = uint(round(st.marched * DISTANCE_SCALE));
+    counts[STAT_GRADIENTS] = st.gradient_evals;
+    counts[STAT_SHADOW_RAYS] = st.shadow_rays;
   }
   uint lid = gl_LocalInvocationIndex;
   [[unroll]] for (uint k = 0u; k < STAT_COUNT; ++k) partial[k][lid] = uvec2(counts[k], 0u);

@@ -1,0 +1,127 @@
+// resoct kernel: octree node addressing and per-channel node classification for the residency
+// traversal (paper 000 Alg. 1, thesis Alg. 7.5), shared by primary rays (traverse.glsl.h) and
+// shadow rays (shadow.glsl.h). See docs/rendering.md ("Traversal").
+//
+// Accessors: resoct_read_node, resoct_read_depth (see traverse.glsl.h).
+#ifndef RESOCT_KERNEL_NODE_CLASS_GLSL_H
+#define RESOCT_KERNEL_NODE_CLASS_GLSL_H
+
+#include "resoct/kernel/common.glsl.h"
+#include "resoct/kernel/frame.glsl.h"
+#include "resoct/kernel/octree_node.glsl.h"
+
+RESOCT_KERNEL_BEGIN
+
+// Node classification of one channel.
+RESOCT_CONST(uint, RESOCT_NODE_CLASS_VISIBLE, 0u);
+RESOCT_CONST(uint, RESOCT_NODE_CLASS_INVALID, 1u);
+RESOCT_CONST(uint, RESOCT_NODE_CLASS_EMPTY, 2u);
+RESOCT_CONST(uint, RESOCT_NODE_CLASS_HOMOGENEOUS, 3u);
+
+RESOCT_CONST(uint, RESOCT_NONE_U, 0xFFFFFFFFu);
+
+/// Child bits of a node coordinate at depth D: the low coordinate bit of each split axis, z then
+/// y then x with x least significant (OctreeLayout's order).
+RESOCT_FN uint resoct_node_child_bits(ResoctDepthInfo D, uvec3 c) {
+  uint bits = 0u;
+  uint shift = 0u;
+  if (D.split_x != 0u) {
+    bits = c.x & 1u;
+    shift = 1u;
+  }
+  if (D.split_y != 0u) {
+    bits = bits | ((c.y & 1u) << shift);
+    shift = shift + 1u;
+  }
+  if (D.split_z != 0u) bits = bits | ((c.z & 1u) << shift);
+  return bits;
+}
+
+/// Coordinates of the node at depth D containing a cell inside the volume.
+RESOCT_FN uvec3 resoct_node_coord(ResoctDepthInfo D, ivec3 cell) {
+  uvec3 c = uvec3(cell) / uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
+  return min(c, uvec3(D.count_x - 1u, D.count_y - 1u, D.count_z - 1u));
+}
+
+/// Classifies one channel at a node from its own metadata record.
+RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
+  uint base = resoct_node_base(node, s.slot, node_slots);
+  uint flags = resoct_read_node(base + RESOCT_NODE_FLAGS);
+  uint state = resoct_node_state(flags);
+  if (state == RESOCT_NODE_INVALID) return RESOCT_NODE_CLASS_INVALID;
+  uint minmax = resoct_read_node(base + RESOCT_NODE_MINMAX);
+  uint occupancy = resoct_read_node(base + RESOCT_NODE_OCCUPANCY);
+  if (!resoct_node_may_be_visible(minmax, occupancy, s.vis_lo16, s.vis_hi16, s.vis_bins)) {
+    return RESOCT_NODE_CLASS_EMPTY;
+  }
+  if (state == RESOCT_NODE_VALID && resoct_node_min16(minmax) == resoct_node_max16(minmax)) {
+    return RESOCT_NODE_CLASS_HOMOGENEOUS;
+  }
+  return RESOCT_NODE_CLASS_VISIBLE;
+}
+
+/// Deepest octree depth whose nodes are at least `dt` long on every axis (smaller nodes cannot
+/// skip more than a step), at least `start_depth`; `vpb` = level-0 voxels per box unit.
+RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, vec3 vpb, float dt) {
+  uint depth = start_depth;
+  for (uint d = start_depth + 1u; d < depth_count; ++d) {
+    ResoctDepthInfo D = resoct_read_depth(d);
+    float sx = float(D.node_extent_x) / vpb.x;
+    float sy = float(D.node_extent_y) / vpb.y;
+    float sz = float(D.node_extent_z) / vpb.z;
+    if (min(sx, min(sy, sz)) < dt) break;
+    depth = d;
+  }
+  return depth;
+}
+
+/// The traversal depth of a primary ray with step dt.
+RESOCT_FN uint resoct_traversal_depth(ResoctFrame f, float dt) {
+  return resoct_traversal_depth_for(
+      f.start_depth, f.depth_count,
+      vec3(f.voxels_per_box_x, f.voxels_per_box_y, f.voxels_per_box_z), dt);
+}
+
+/// log2 of the node counts per axis at depth D (counts are powers of two).
+RESOCT_FN uvec3 resoct_depth_count_log2(ResoctDepthInfo D) {
+  return uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
+}
+
+/// Coordinates at depth D of the ancestor of the node with coordinates `deep` at a deeper depth
+/// whose count_log2 is `deep_log2`: node boxes nest exactly, so this is a shift, not a division.
+RESOCT_FN uvec3 resoct_ancestor_coord(ResoctDepthInfo D, uvec3 deep, uvec3 deep_log2) {
+  return deep >> (deep_log2 - resoct_depth_count_log2(D));
+}
+
+/// Flat index of the node at depth `depth` whose coordinates are `coord` (count_log2
+/// `coord_log2`), built from the root by child bits.
+RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
+  uint local = 0u;
+  for (uint d = 1u; d <= depth; ++d) {
+    ResoctDepthInfo D = resoct_read_depth(d);
+    local = (local << D.child_shift) |
+            resoct_node_child_bits(D, resoct_ancestor_coord(D, coord, coord_log2));
+  }
+  return resoct_read_depth(depth).first_node + local;
+}
+
+/// Class of a channel at the node of depth `depth` on the path to (coord, coord_log2): its own
+/// record if it has metadata, else that of the nearest ancestor (down to `top`) that has, since a
+/// parent's record covers its children; INVALID when none has.
+RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
+                                         uvec3 coord_log2, ResoctSlotInfo s, uint node_slots) {
+  uint cls = resoct_node_class(node, s, node_slots);
+  uint d = depth;
+  while (cls == RESOCT_NODE_CLASS_INVALID && d > top) {
+    d = d - 1u;
+    ResoctDepthInfo D = resoct_read_depth(d);
+    cls = resoct_node_class(resoct_node_index(d, resoct_ancestor_coord(D, coord, coord_log2),
+                                              resoct_depth_count_log2(D)),
+                            s, node_slots);
+  }
+  return cls;
+}
+
+RESOCT_KERNEL_END
+
+#endif  // RESOCT_KERNEL_NODE_CLASS_GLSL_H

@@ -1,0 +1,10 @@
+// The mask-0 kernel: a scene without effects runs exactly this (see kernel_access.hpp).
+#include "kernel_access.hpp"
+
+namespace resoct::cpu::detail {
+
+RayTotals render_plain(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
+  return render_tiles<0u>(frame, pixels, threads);
+}
+
+}  // namespace resoct::cpu::detail
