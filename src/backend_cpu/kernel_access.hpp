@@ -158,6 +158,18 @@ struct RayTotals {
   double skipped = 0.0, marched = 0.0;
 };
 
+// The plain (mask-0) kernel with every kernel helper inlined into it. Left to GCC's growth
+// heuristics, the inlining of the page-table/octree/residency channel helpers and the camera
+// ray into the march changed with every feature added to the kernel unit (effects, slices,
+// lens), each time costing instructions per sample on the path of scenes that use none of
+// them; flattening makes the plain path's code independent of those features. Only mask 0 is
+// flattened: the effect kernels' shadow and gradient marches would multiply in size.
+[[gnu::flatten]] inline glm::vec4 resoct_render_pixel_plain(const kernel::ResoctFrame& frame,
+                                                            std::uint32_t x, std::uint32_t y,
+                                                            kernel::ResoctRayStats& st) {
+  return kernel::resoct_render_pixel_fx<0u>(frame, x, y, st);
+}
+
 // All tiles of one frame with the kernel specialized for the effect mask EFFECTS: the mask is
 // chosen once per frame (render()), so no sample ever branches on it at run time.
 template <std::uint32_t EFFECTS>
@@ -181,7 +193,12 @@ RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int 
     for (std::uint32_t y = ty; y < y1; ++y) {
       for (std::uint32_t x = tx; x < x1; ++x) {
         kernel::ResoctRayStats st{};
-        const glm::vec4 p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
+        glm::vec4 p;
+        if constexpr (EFFECTS == 0u) {
+          p = resoct_render_pixel_plain(frame, x, y, st);
+        } else {
+          p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
+        }
         // The image holds straight alpha (docs/rendering.md "Compositing").
         pixels[std::size_t(y) * frame.width + x] =
             p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
