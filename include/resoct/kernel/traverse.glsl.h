@@ -141,157 +141,204 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     resoct_segments_begin(f, segs, o_cell, o_frac, dir_vox, t, t_exit);
     t_exit = t;
   }
-  while (t_exit - t > RESOCT_SEGMENT_EPS * dt ||
-         (segs.enabled != 0u &&
-          resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc,
-                                 live, bank, cached_node, cached_coord, stats))) {
-    if (stats.iterations >= f.max_iterations) {
-      stats.cap_hits = 1u;
-      break;
-    }
-    stats.iterations = stats.iterations + 1u;
-    float seg = resoct_segment_length(t, dt, t_exit);
-    float tm = t + 0.5f * seg;
-    ivec3 cell;
-    vec3 frac;
-    resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
-    resoct_clamp_position(f, cell, frac);
+  // One pass of the outer loop per segment (a single pass without slices and lens). The segment
+  // switch stays out of the march loop's condition: there it made lavapipe's compiler take
+  // extra loop back-edges per step, which count against the driver's per-invocation loop guard
+  // (docs/vulkan-backend.md) and cut long rays short.
+  bool stop = false;
+  for (;;) {
+    while (t_exit - t > RESOCT_SEGMENT_EPS * dt) {
+      if (stats.iterations >= f.max_iterations) {
+        stats.cap_hits = 1u;
+        stop = true;
+        break;
+      }
+      stats.iterations = stats.iterations + 1u;
+      float seg = resoct_segment_length(t, dt, t_exit);
+      float tm = t + 0.5f * seg;
+      ivec3 cell;
+      vec3 frac;
+      resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
+      resoct_clamp_position(f, cell, frac);
 
-    float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
-                                          resoct_view_depth(f, dir_box, tm), f.lod_error_px);
-    uint lod = resoct_lod_level(budget, f.level_count);
+      float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
+                                            resoct_view_depth(f, dir_box, tm), f.lod_error_px);
+      uint lod = resoct_lod_level(budget, f.level_count);
 
-    vec4 weighted;
-    float combined;
-    resoct_mix_begin(weighted, combined);
-    bool any_value = false;
-    bool skip = false;
-    // Effects: the channels' values are collected and handled by one call below, so the GPU
-    // compiler inlines the effect code once, not once per render mode.
-    float fx_value[RESOCT_MAX_SLOTS];
-    uint fx_level[RESOCT_MAX_SLOTS];
-    uint fx_have = 0u;
-    float skip_exit = RESOCT_RAY_T_INF;
+      vec4 weighted;
+      float combined;
+      resoct_mix_begin(weighted, combined);
+      bool any_value = false;
+      bool skip = false;
+      // Effects: the channels' values are collected and handled by one call below, so the GPU
+      // compiler inlines the effect code once, not once per render mode.
+      float fx_value[RESOCT_MAX_SLOTS];
+      uint fx_level[RESOCT_MAX_SLOTS];
+      uint fx_have = 0u;
+      float skip_exit = RESOCT_RAY_T_INF;
 
-    if (f.mode == RESOCT_MODE_RESIDENCY) {
-      uvec3 trav_coord = resoct_node_coord(trav_info, cell);
-      // Consecutive samples mostly stay in one node: skip the index walk then.
-      bool same_node = all(equal(trav_coord, cached_coord));
-      uint node = same_node ? cached_node : resoct_node_index(trav_depth, trav_coord, trav_log2);
-      cached_coord = trav_coord;
-      if (node != cached_node) {
-        // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
-        // node advances the channel index in the same node.
-        cached_node = node;
-        cached_empty = 0u;
-        cached_homog = 0u;
-        cached_skip_depth = RESOCT_NONE_U;
-        uint ci = 0u;
-        uint local = 0u;
-        for (uint d = 0u; d <= trav_depth; ++d) {
-          ResoctDepthInfo D = resoct_read_depth(d);
-          if (d > 0u) {
-            local = (local << D.child_shift) |
-                    resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
+      if (f.mode == RESOCT_MODE_RESIDENCY) {
+        uvec3 trav_coord = resoct_node_coord(trav_info, cell);
+        // Consecutive samples mostly stay in one node: skip the index walk then.
+        bool same_node = all(equal(trav_coord, cached_coord));
+        uint node = same_node ? cached_node : resoct_node_index(trav_depth, trav_coord, trav_log2);
+        cached_coord = trav_coord;
+        if (node != cached_node) {
+          // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
+          // node advances the channel index in the same node.
+          cached_node = node;
+          cached_empty = 0u;
+          cached_homog = 0u;
+          cached_skip_depth = RESOCT_NONE_U;
+          uint ci = 0u;
+          uint local = 0u;
+          for (uint d = 0u; d <= trav_depth; ++d) {
+            ResoctDepthInfo D = resoct_read_depth(d);
+            if (d > 0u) {
+              local = (local << D.child_shift) |
+                      resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
+            }
+            if (d < f.start_depth) continue;
+            uint nd = D.first_node + local;
+            stats.nodes = stats.nodes + 1u;
+            while (ci < n) {
+              bool empty = ((live >> ci) & 1u) == 0u;
+              if (!empty) {
+                uint cls;
+                RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                  cls = resoct_mode_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                                                       resoct_read_slot(bank + ci),
+                                                       f.node_slot_count, fx.proj[ci]);
+                }
+                else {
+                  cls = resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                                                  resoct_read_slot(bank + ci), f.node_slot_count);
+                }
+                empty = cls == RESOCT_NODE_CLASS_EMPTY;
+              }
+              if (!empty) break;
+              cached_empty = cached_empty | (1u << ci);
+              ci = ci + 1u;
+            }
+            if (ci == n) {
+              cached_skip_depth = d;
+              break;
+            }
           }
-          if (d < f.start_depth) continue;
-          uint nd = D.first_node + local;
-          stats.nodes = stats.nodes + 1u;
-          while (ci < n) {
-            bool empty = ((live >> ci) & 1u) == 0u;
-            if (!empty) {
+          if (cached_skip_depth == RESOCT_NONE_U) {
+            // The remaining channels at the traversal node. A node whose own record is INVALID
+            // is requested; its class is carried down from the nearest ancestor with metadata
+            // (not empty when there is none).
+            bool invalid = false;
+            for (uint c = ci; c < n; ++c) {
+              if (((live >> c) & 1u) == 0u) {
+                cached_empty = cached_empty | (1u << c);
+                continue;
+              }
+              ResoctSlotInfo sc = resoct_read_slot(bank + c);
               uint cls;
               RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                cls = resoct_mode_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
-                                                     resoct_read_slot(bank + ci), f.node_slot_count,
-                                                     fx.proj[ci]);
+                cls = resoct_mode_node_class(node, sc, f.node_slot_count, fx.proj[c]);
               }
               else {
-                cls = resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
-                                                resoct_read_slot(bank + ci), f.node_slot_count);
+                cls = resoct_node_class(node, sc, f.node_slot_count);
               }
-              empty = cls == RESOCT_NODE_CLASS_EMPTY;
-            }
-            if (!empty) break;
-            cached_empty = cached_empty | (1u << ci);
-            ci = ci + 1u;
-          }
-          if (ci == n) {
-            cached_skip_depth = d;
-            break;
-          }
-        }
-        if (cached_skip_depth == RESOCT_NONE_U) {
-          // The remaining channels at the traversal node. A node whose own record is INVALID
-          // is requested; its class is carried down from the nearest ancestor with metadata
-          // (not empty when there is none).
-          bool invalid = false;
-          for (uint c = ci; c < n; ++c) {
-            if (((live >> c) & 1u) == 0u) {
-              cached_empty = cached_empty | (1u << c);
-              continue;
-            }
-            ResoctSlotInfo sc = resoct_read_slot(bank + c);
-            uint cls;
-            RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-              cls = resoct_mode_node_class(node, sc, f.node_slot_count, fx.proj[c]);
-            }
-            else {
-              cls = resoct_node_class(node, sc, f.node_slot_count);
-            }
-            if (cls == RESOCT_NODE_CLASS_INVALID) {
-              invalid = true;
-              RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                cls = resoct_mode_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
+              if (cls == RESOCT_NODE_CLASS_INVALID) {
+                invalid = true;
+                RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                  cls =
+                      resoct_mode_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
                                                      trav_log2, sc, f.node_slot_count, fx.proj[c]);
+                }
+                else {
+                  cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
+                                                  trav_log2, sc, f.node_slot_count);
+                }
+                // A homogeneous ancestor's value is only known at the ancestor: read it there.
+                if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
+              }
+              if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
+              if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
+            }
+            if (invalid && node != last_node_request) {
+              last_node_request = node;
+              resoct_report_node_request(node);
+              stats.requests = stats.requests + 1u;
+            }
+            uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
+            if (cached_empty == all) cached_skip_depth = trav_depth;
+          }
+        }
+        if (cached_skip_depth != RESOCT_NONE_U) {
+          ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
+          uvec3 nc = resoct_node_coord(Ds, cell);
+          uvec3 ne = uvec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
+          skip = true;
+          skip_exit = resoct_box_exit(cell, frac, dir_vox, ivec3(nc * ne), vec3(ne));
+        } else {
+          for (uint c = 0u; c < n; ++c) {
+            if (((cached_empty >> c) & 1u) != 0u) continue;
+            ResoctSlotInfo s = resoct_read_slot(bank + c);
+            float value = 0.0f;
+            uint res = RESOCT_CH_NONE;
+            uint target = 0u;
+            if (((cached_homog >> c) & 1u) != 0u) {
+              uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
+                                         RESOCT_NODE_MINMAX);
+              value = float(resoct_node_min16(mm)) / 65535.0f;
+              res = RESOCT_CH_VALUE;
+            } else {
+              target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
+                                             stats);
+            }
+            if (res == RESOCT_CH_VALUE) {
+              RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+                uint level = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+                RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
+                  level = resoct_present_level(sp, s, node, level, cell);
+                }
+                fx_value[c] = value;
+                fx_level[c] = level;
+                fx_have = fx_have | (1u << c);
               }
               else {
-                cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
-                                                trav_log2, sc, f.node_slot_count);
+                vec4 rgba = resoct_tf_lookup(s.slot, value);
+                resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
+                               resoct_correct_opacity(rgba.a, seg / f.ref_step));
               }
-              // A homogeneous ancestor's value is only known at the ancestor: read it there.
-              if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
+              any_value = true;
             }
-            if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
-            if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
           }
-          if (invalid && node != last_node_request) {
-            last_node_request = node;
-            resoct_report_node_request(node);
-            stats.requests = stats.requests + 1u;
-          }
-          uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
-          if (cached_empty == all) cached_skip_depth = trav_depth;
         }
-      }
-      if (cached_skip_depth != RESOCT_NONE_U) {
-        ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
-        uvec3 nc = resoct_node_coord(Ds, cell);
-        uvec3 ne = uvec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
-        skip = true;
-        skip_exit = resoct_box_exit(cell, frac, dir_vox, ivec3(nc * ne), vec3(ne));
       } else {
+        // Page-table and standard-octree modes: channels independently; skip only when every
+        // live channel is EMPTY, to the nearest EMPTY-brick exit.
+        bool all_empty = true;
         for (uint c = 0u; c < n; ++c) {
-          if (((cached_empty >> c) & 1u) != 0u) continue;
+          if (((live >> c) & 1u) == 0u) continue;
           ResoctSlotInfo s = resoct_read_slot(bank + c);
+          uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
           float value = 0.0f;
-          uint res = RESOCT_CH_NONE;
-          uint target = 0u;
-          if (((cached_homog >> c) & 1u) != 0u) {
-            uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
-                                       RESOCT_NODE_MINMAX);
-            value = float(resoct_node_min16(mm)) / 65535.0f;
-            res = RESOCT_CH_VALUE;
+          float exit_c = 0.0f;
+          uint res;
+          if (f.mode == RESOCT_MODE_OCTREE) {
+            res = resoct_octree_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
+                                        exit_c, stats);
           } else {
-            target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-            res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
-                                           stats);
+            res = resoct_pagetable_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
+                                           exit_c, stats);
+          }
+          if (res == RESOCT_CH_EMPTY) {
+            skip_exit = min(skip_exit, exit_c);
+          } else {
+            all_empty = false;
           }
           if (res == RESOCT_CH_VALUE) {
             RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-              uint level = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              uint level = target;
               RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-                level = resoct_present_level(sp, s, node, level, cell);
+                if (f.mode == RESOCT_MODE_OCTREE) level = resoct_octree_level(sp, s, target, cell);
               }
               fx_value[c] = value;
               fx_level[c] = level;
@@ -305,76 +352,43 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             any_value = true;
           }
         }
+        skip = all_empty;
       }
-    } else {
-      // Page-table and standard-octree modes: channels independently; skip only when every
-      // live channel is EMPTY, to the nearest EMPTY-brick exit.
-      bool all_empty = true;
-      for (uint c = 0u; c < n; ++c) {
-        if (((live >> c) & 1u) == 0u) continue;
-        ResoctSlotInfo s = resoct_read_slot(bank + c);
-        uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-        float value = 0.0f;
-        float exit_c = 0.0f;
-        uint res;
-        if (f.mode == RESOCT_MODE_OCTREE) {
-          res = resoct_octree_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
-                                      exit_c, stats);
-        } else {
-          res = resoct_pagetable_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
-                                         exit_c, stats);
-        }
-        if (res == RESOCT_CH_EMPTY) {
-          skip_exit = min(skip_exit, exit_c);
-        } else {
-          all_empty = false;
-        }
-        if (res == RESOCT_CH_VALUE) {
-          RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-            uint level = target;
-            RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-              if (f.mode == RESOCT_MODE_OCTREE) level = resoct_octree_level(sp, s, target, cell);
-            }
-            fx_value[c] = value;
-            fx_level[c] = level;
-            fx_have = fx_have | (1u << c);
-          }
-          else {
-            vec4 rgba = resoct_tf_lookup(s.slot, value);
-            resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
-                           resoct_correct_opacity(rgba.a, seg / f.ref_step));
-          }
-          any_value = true;
+
+      RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+        for (uint c = 0u; c < n; ++c) {
+          if (((fx_have >> c) & 1u) == 0u) continue;
+          RESOCT_FX(resoct_fx_channel)
+          (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], lod, seg, tm, cell,
+           frac, fx, weighted, combined, acc, stats);
         }
       }
-      skip = all_empty;
-    }
 
-    RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-      for (uint c = 0u; c < n; ++c) {
-        if (((fx_have >> c) & 1u) == 0u) continue;
-        RESOCT_FX(resoct_fx_channel)
-        (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], lod, seg, tm, cell,
-         frac, fx, weighted, combined, acc, stats);
+      if (any_value) {
+        stats.samples = stats.samples + 1u;
+        acc = resoct_composite(acc, resoct_mix_result(weighted, combined));
+        if (resoct_saturated(acc, f.ert_opacity)) {
+          stop = true;
+          break;
+        }
+      }
+
+      if (skip) {
+        // First grid segment whose midpoint lies past the exit: sample positions stay those of
+        // an unskipped march.
+        float k = max(1.0f, ceil((0.5f * seg + skip_exit - 0.5f * dt) / dt));
+        float t_next = resoct_advance_t(t, k * dt);
+        stats.skipped = stats.skipped + (min(t_next, t_exit) - t);
+        t = t_next;
+      } else {
+        stats.marched = stats.marched + seg;
+        t = resoct_advance_t(t, seg);
       }
     }
-
-    if (any_value) {
-      stats.samples = stats.samples + 1u;
-      acc = resoct_composite(acc, resoct_mix_result(weighted, combined));
-      if (resoct_saturated(acc, f.ert_opacity)) break;
-    }
-
-    if (skip) {
-      // First grid segment whose midpoint lies past the exit: sample positions stay those of
-      // an unskipped march.
-      float k = max(1.0f, ceil((0.5f * seg + skip_exit - 0.5f * dt) / dt));
-      float t_next = resoct_advance_t(t, k * dt);
-      stats.skipped = stats.skipped + (min(t_next, t_exit) - t);
-      t = t_next;
-    } else {
-      stats.marched = stats.marched + seg;
-      t = resoct_advance_t(t, seg);
+    if (stop || segs.enabled == 0u ||
+        !resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc, live,
+                                bank, cached_node, cached_coord, stats)) {
+      break;
     }
   }
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
