@@ -1,8 +1,10 @@
 // build_frame_tables against the double-precision camera (CameraRays) and hierarchy: the
 // kernel's per-pixel rays, the exact eye split and the sampling constants.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include "resoct/camera.hpp"
@@ -123,6 +125,73 @@ TEST(FrameTables, SamplingConstants) {
   }
   EXPECT_GT(t.frame.min_step, 0.0f);
   EXPECT_LT(t.frame.min_step, 1e-3f * t.frame.ref_step);
+}
+
+// The step follows the finest level any sample can pick (docs/rendering.md, "Step size"):
+// brute force over a grid of points in the volume, each point's level by the LOD rule's
+// definition (coarsest level whose voxel fits the pixel footprint at its view depth).
+std::uint32_t step_level(const FrameTables& t, const BrickHierarchy& h) {
+  for (std::uint32_t l = 0; l < h.level_count(); ++l) {
+    if (float(level_voxel_size(h, l).x) == t.frame.finest_voxel_x) return l;
+  }
+  ADD_FAILURE() << "finest_voxel_x matches no level";
+  return 0;
+}
+
+std::uint32_t finest_level_picked(const Scene& s, const BrickHierarchy& h) {
+  const CameraRays rays(s.camera, s.viewport);
+  const glm::dvec3 ext = box_extent(h.volume());
+  const std::vector<float> sizes = level_size_log2_table(h);
+  std::uint32_t finest = ~0u;
+  for (int i = 0; i <= 8; ++i) {
+    for (int j = 0; j <= 8; ++j) {
+      for (int k = 0; k <= 8; ++k) {
+        const glm::dvec3 p = ext * glm::dvec3(i, j, k) / 8.0;
+        const double depth = glm::dot(p - s.camera.eye, rays.forward());
+        const double budget = std::log2(rays.footprint(depth) * s.lod_error_px);
+        std::uint32_t level = 0;
+        for (std::uint32_t l = 1; l < sizes.size() && double(sizes[l]) <= budget; ++l) level = l;
+        finest = std::min(finest, level);
+      }
+    }
+  }
+  return finest;
+}
+
+TEST(FrameTables, StepFollowsTheFinestLevelAnySampleCanPick) {
+  VolumeDesc v;
+  v.extent = {1024, 1024, 1024};
+  Fixture fx(v);
+  Camera far;
+  far.eye = {0.5, 0.5, 3.0};
+  Scene s = scene_with(far, {64, 64});
+  s.channels[0].coarsest_level = kMaxSceneLevel;
+  const FrameTables t = build_frame_tables(s, fx.hierarchy, fx.layout, fx.channels);
+  const std::uint32_t picked = finest_level_picked(s, fx.hierarchy);
+  ASSERT_GE(picked, 2u) << "the far view must be coarse for this test to mean anything";
+  ASSERT_LT(picked + 1, fx.hierarchy.level_count()) << "room for a coarser finest level";
+  // Never coarser than a sample needs; at most one level finer (the 1e-3 rounding margin).
+  EXPECT_LE(step_level(t, fx.hierarchy), picked);
+  EXPECT_GE(step_level(t, fx.hierarchy) + 1, picked);
+
+  // A channel's own range still bounds the step level: finer than allowed never, coarser than
+  // its coarsest never.
+  s.channels[0].finest_level = picked + 1;
+  EXPECT_EQ(step_level(build_frame_tables(s, fx.hierarchy, fx.layout, fx.channels), fx.hierarchy),
+            picked + 1);
+  s.channels[0].finest_level = 0;
+  s.channels[0].coarsest_level = 1;
+  EXPECT_EQ(step_level(build_frame_tables(s, fx.hierarchy, fx.layout, fx.channels), fx.hierarchy),
+            1u);
+
+  // A camera inside the volume can pick level 0, so the step is level 0's.
+  Camera inside;
+  inside.eye = {0.5, 0.5, 0.5};
+  inside.target = {0.5, 0.5, 0.0};
+  Scene near = scene_with(inside, {64, 64});
+  near.channels[0].coarsest_level = kMaxSceneLevel;
+  EXPECT_EQ(
+      step_level(build_frame_tables(near, fx.hierarchy, fx.layout, fx.channels), fx.hierarchy), 0u);
 }
 
 }  // namespace
