@@ -69,8 +69,7 @@ void LazyMetadata::store(const Key& k, const RegionMeta& m) const {
 }
 
 RegionMeta LazyMetadata::query(std::uint32_t channel, const Box3& level0_region) const {
-  const Box3 r =
-      intersect(level0_region, Box3{glm::i64vec3(0), glm::i64vec3(desc_.extent)});
+  const Box3 r = intersect(level0_region, Box3{glm::i64vec3(0), glm::i64vec3(desc_.extent)});
   if (r.empty()) return RegionMeta{};
   const auto bs = std::int64_t(block_);
   const glm::u64vec3 b0(r.lo / bs), b1((r.hi - std::int64_t(1)) / bs);

@@ -54,7 +54,9 @@ class LazyMetadata {
   Shard& shard(const Key& k) const { return shards_[KeyHash{}(k) % kShards]; }
   bool lookup(const Key& k, RegionMeta& out) const;
   void store(const Key& k, const RegionMeta& m) const;
-  std::uint64_t linear(const glm::u64vec3& b) const { return (b.z * blocks_.y + b.y) * blocks_.x + b.x; }
+  std::uint64_t linear(const glm::u64vec3& b) const {
+    return (b.z * blocks_.y + b.y) * blocks_.x + b.x;
+  }
 
   VolumeDesc desc_;
   LevelBoxReader level0_;

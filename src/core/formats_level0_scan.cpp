@@ -87,7 +87,8 @@ void tile_minmax(std::span<const std::byte> voxels, double& lo, double& hi) {
 
 template <typename T>
 void block_metas(const Box3& box, std::span<const std::byte> voxels, const ValueRange& r,
-                 const std::vector<std::uint32_t>& lut, std::int64_t bs, std::span<RegionMeta> meta) {
+                 const std::vector<std::uint32_t>& lut, std::int64_t bs,
+                 std::span<RegionMeta> meta) {
   const glm::i64vec3 s = box.size();
   const glm::i64vec3 b0 = box.lo / bs, b1 = (box.hi - std::int64_t(1)) / bs;
   const glm::i64vec3 nb = b1 - b0 + std::int64_t(1);
@@ -152,8 +153,8 @@ std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r) {
 }
 
 void block_metadata(VoxelType t, const Box3& box, std::span<const std::byte> voxels,
-                    const ValueRange& r, const std::vector<std::uint32_t>& lut,
-                    std::uint32_t block, std::span<RegionMeta> out) {
+                    const ValueRange& r, const std::vector<std::uint32_t>& lut, std::uint32_t block,
+                    std::span<RegionMeta> out) {
   const auto bs = std::int64_t(block);
   switch (t) {
     case VoxelType::u8: block_metas<std::uint8_t>(box, voxels, r, lut, bs, out); break;

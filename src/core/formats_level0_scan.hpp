@@ -23,8 +23,8 @@ std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r);
 /// `block` that the box touches (x fastest over the block range of the box). `lut` is
 /// occupancy_lut(t, r).
 void block_metadata(VoxelType t, const Box3& box, std::span<const std::byte> voxels,
-                    const ValueRange& r, const std::vector<std::uint32_t>& lut,
-                    std::uint32_t block, std::span<RegionMeta> out);
+                    const ValueRange& r, const std::vector<std::uint32_t>& lut, std::uint32_t block,
+                    std::span<RegionMeta> out);
 
 /// Merges every level-0 voxel into the finest entries of `pyramid` (which must match desc) and
 /// builds it.

@@ -78,8 +78,7 @@ PyramidSource::PyramidSource(VolumeDesc desc, BrickLayout layout,
     if (scan) {
       VolumeDesc level_desc = d;
       level_desc.extent = hierarchy_.level(scan_level).extent;
-      const auto mm =
-          detail::scan_finite_minmax(level_desc, levels_[scan_level], options.threads);
+      const auto mm = detail::scan_finite_minmax(level_desc, levels_[scan_level], options.threads);
       d.ranges.clear();
       for (const auto& [lo, hi] : mm) d.ranges.push_back(data_value_range(lo, hi));
       hierarchy_ = BrickHierarchy(d, layout);
