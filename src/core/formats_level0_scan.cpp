@@ -85,24 +85,13 @@ void tile_minmax(std::span<const std::byte> voxels, double& lo, double& hi) {
   }
 }
 
-/// Integer types: the occupancy bit of every possible value, looked up instead of recomputed.
-std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r) {
-  std::vector<std::uint32_t> lut;
-  if (t == VoxelType::f32) return lut;
-  lut.resize(t == VoxelType::u8 ? 256u : 65536u);
-  for (std::size_t v = 0; v < lut.size(); ++v) lut[v] = occupancy_bit(double(v), r);
-  return lut;
-}
-
 template <typename T>
-void tile_metadata(const Box3& box, std::span<const std::byte> voxels, const ValueRange& r,
-                   const std::vector<std::uint32_t>& lut, std::uint32_t channel,
-                   MetadataPyramid& pyramid) {
-  const auto bs = std::int64_t(pyramid.block_size());
+void block_metas(const Box3& box, std::span<const std::byte> voxels, const ValueRange& r,
+                 const std::vector<std::uint32_t>& lut, std::int64_t bs,
+                 std::span<RegionMeta> meta) {
   const glm::i64vec3 s = box.size();
   const glm::i64vec3 b0 = box.lo / bs, b1 = (box.hi - std::int64_t(1)) / bs;
   const glm::i64vec3 nb = b1 - b0 + std::int64_t(1);
-  std::vector<RegionMeta> meta(std::size_t(nb.x * nb.y * nb.z));
   for (std::int64_t z = 0; z < s.z; ++z) {
     for (std::int64_t y = 0; y < s.y; ++y) {
       const std::size_t row = std::size_t((z * s.y + y) * s.x);
@@ -128,6 +117,16 @@ void tile_metadata(const Box3& box, std::span<const std::byte> voxels, const Val
       }
     }
   }
+}
+
+void tile_metadata(const Box3& box, std::span<const std::byte> voxels, VoxelType t,
+                   const ValueRange& r, const std::vector<std::uint32_t>& lut,
+                   std::uint32_t channel, MetadataPyramid& pyramid) {
+  const auto bs = std::int64_t(pyramid.block_size());
+  const glm::i64vec3 b0 = box.lo / bs, b1 = (box.hi - std::int64_t(1)) / bs;
+  const glm::i64vec3 nb = b1 - b0 + std::int64_t(1);
+  std::vector<RegionMeta> meta(std::size_t(nb.x * nb.y * nb.z));
+  block_metadata(t, box, voxels, r, lut, pyramid.block_size(), meta);
   for (std::int64_t z = 0; z < nb.z; ++z) {
     for (std::int64_t y = 0; y < nb.y; ++y) {
       for (std::int64_t x = 0; x < nb.x; ++x) {
@@ -143,6 +142,26 @@ std::uint64_t tile_edge(std::uint32_t block) {
 }
 
 }  // namespace
+
+std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r) {
+  std::vector<std::uint32_t> lut;
+  if (t == VoxelType::f32) return lut;
+  // Integer types: the occupancy bit of every possible value, looked up instead of recomputed.
+  lut.resize(t == VoxelType::u8 ? 256u : 65536u);
+  for (std::size_t v = 0; v < lut.size(); ++v) lut[v] = occupancy_bit(double(v), r);
+  return lut;
+}
+
+void block_metadata(VoxelType t, const Box3& box, std::span<const std::byte> voxels,
+                    const ValueRange& r, const std::vector<std::uint32_t>& lut, std::uint32_t block,
+                    std::span<RegionMeta> out) {
+  const auto bs = std::int64_t(block);
+  switch (t) {
+    case VoxelType::u8: block_metas<std::uint8_t>(box, voxels, r, lut, bs, out); break;
+    case VoxelType::u16: block_metas<std::uint16_t>(box, voxels, r, lut, bs, out); break;
+    case VoxelType::f32: block_metas<float>(box, voxels, r, lut, bs, out); break;
+  }
+}
 
 std::vector<std::pair<double, double>> scan_finite_minmax(const VolumeDesc& desc,
                                                           const LevelBoxReader& level0,
@@ -173,17 +192,7 @@ void fill_metadata(const VolumeDesc& desc, const LevelBoxReader& level0, Metadat
   }
   for_each_tile(desc, level0, tile_edge(pyramid.block_size()), threads,
                 [&](const Box3& box, std::uint32_t c, std::span<const std::byte> v) {
-                  const ValueRange r = desc.range(c);
-                  const auto& lut = luts[c];
-                  switch (desc.type) {
-                    case VoxelType::u8:
-                      tile_metadata<std::uint8_t>(box, v, r, lut, c, pyramid);
-                      break;
-                    case VoxelType::u16:
-                      tile_metadata<std::uint16_t>(box, v, r, lut, c, pyramid);
-                      break;
-                    case VoxelType::f32: tile_metadata<float>(box, v, r, lut, c, pyramid); break;
-                  }
+                  tile_metadata(box, v, desc.type, desc.range(c), luts[c], c, pyramid);
                 });
   pyramid.build();
 }

@@ -3,6 +3,7 @@
 // tile by tile through a LevelBoxReader on several threads.
 
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -14,6 +15,16 @@ namespace resoct::detail {
 std::vector<std::pair<double, double>> scan_finite_minmax(const VolumeDesc& desc,
                                                           const LevelBoxReader& level0,
                                                           std::uint32_t threads);
+
+/// Occupancy bit of every value of an integer type over r (empty for f32).
+std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r);
+
+/// Widens out[i] by the voxels (dense, x fastest) of `box`, for every metadata block of edge
+/// `block` that the box touches (x fastest over the block range of the box). `lut` is
+/// occupancy_lut(t, r).
+void block_metadata(VoxelType t, const Box3& box, std::span<const std::byte> voxels,
+                    const ValueRange& r, const std::vector<std::uint32_t>& lut, std::uint32_t block,
+                    std::span<RegionMeta> out);
 
 /// Merges every level-0 voxel into the finest entries of `pyramid` (which must match desc) and
 /// builds it.

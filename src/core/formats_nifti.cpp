@@ -1,4 +1,5 @@
 #include <array>
+#include <limits>
 #include <string>
 
 #include "formats_inflate.hpp"
@@ -55,6 +56,9 @@ std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayo
   if (file.size() >= 2) file.read_at(0, magic);
   PyramidSourceOptions o;
   o.ranges_from_data = true;
+  // The voxels are read (or mapped) whole at open anyway, so the scan adds at most as much
+  // again, and data-derived ranges beat a type's default range for float data.
+  o.eager_scan_voxels = std::numeric_limits<std::uint64_t>::max();
   if (detail::is_gzip(magic)) {
     std::vector<std::byte> packed(std::size_t(file.size()));
     file.read_at(0, packed);

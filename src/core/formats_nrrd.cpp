@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 
 #include "formats_inflate.hpp"
@@ -93,6 +94,9 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   const std::uint64_t need = h.data_bytes();
   PyramidSourceOptions o;
   o.ranges_from_data = true;
+  // The voxels are read (or mapped) whole at open anyway, so the scan adds at most as much
+  // again, and data-derived ranges beat a type's default range for float data.
+  o.eager_scan_voxels = std::numeric_limits<std::uint64_t>::max();
   const std::string name = path;
 
   std::vector<std::byte> stored;

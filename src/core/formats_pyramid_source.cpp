@@ -4,6 +4,7 @@
 #include <cstring>
 #include <string>
 
+#include "formats_lazy_metadata.hpp"
 #include "formats_level0_scan.hpp"
 #include "resoct/downsample.hpp"
 #include "resoct/error.hpp"
@@ -20,6 +21,8 @@ VolumeDesc checked(VolumeDesc desc, const std::vector<LevelBoxReader>& levels,
   if (b < 4 || b > 1024 || (b & (b - 1)) != 0) {
     throw invalid_parameter("metadata_block", "must be a power of two in 4..1024");
   }
+  if (o.lazy_query_blocks == 0) throw invalid_parameter("lazy_query_blocks", "must be > 0");
+  if (o.lazy_cache_entries == 0) throw invalid_parameter("lazy_cache_entries", "must be > 0");
   return desc;
 }
 
@@ -57,14 +60,44 @@ PyramidSource::PyramidSource(VolumeDesc desc, BrickLayout layout,
       name_(std::move(name)),
       cache_(std::make_unique<HostBrickCache>(options.cache_bytes)) {
   VolumeDesc d = hierarchy_.volume();
+  const std::uint64_t voxels0 = d.voxel_count();
+  const bool eager = voxels0 <= options.eager_scan_voxels / d.channels;
   if (options.ranges_from_data) {
-    const auto mm = detail::scan_finite_minmax(d, levels_[0], options.threads);
-    d.ranges.clear();
-    for (const auto& [lo, hi] : mm) d.ranges.push_back(data_value_range(lo, hi));
-    hierarchy_ = BrickHierarchy(d, layout);
+    // Lazily: the coarsest stored level that fits the eager budget estimates the ranges (its
+    // averaged voxels may miss thin extremes, which only coarsens the occupancy bins; the
+    // block summaries themselves stay exact).
+    std::uint32_t scan_level = 0;
+    bool scan = eager;
+    for (std::uint32_t l = hierarchy_.level_count(); !scan && l-- > 1;) {
+      const glm::u64vec3 e = hierarchy_.level(l).extent;
+      if (stored_level(l) && e.x * e.y * e.z <= options.eager_scan_voxels / d.channels) {
+        scan_level = l;
+        scan = true;
+      }
+    }
+    if (scan) {
+      VolumeDesc level_desc = d;
+      level_desc.extent = hierarchy_.level(scan_level).extent;
+      const auto mm = detail::scan_finite_minmax(level_desc, levels_[scan_level], options.threads);
+      d.ranges.clear();
+      for (const auto& [lo, hi] : mm) d.ranges.push_back(data_value_range(lo, hi));
+      hierarchy_ = BrickHierarchy(d, layout);
+    }
   }
-  pyramid_ = MetadataPyramid(d.extent, options.metadata_block, d.channels);
-  detail::fill_metadata(d, levels_[0], pyramid_, options.threads);
+  if (eager) {
+    pyramid_ = MetadataPyramid(d.extent, options.metadata_block, d.channels);
+    detail::fill_metadata(d, levels_[0], pyramid_, options.threads);
+  } else {
+    lazy_ = std::make_unique<detail::LazyMetadata>(d, levels_[0], options.metadata_block,
+                                                   options.lazy_query_blocks,
+                                                   options.lazy_cache_entries);
+  }
+}
+
+PyramidSource::~PyramidSource() = default;
+
+std::uint64_t PyramidSource::lazy_blocks_computed() const noexcept {
+  return lazy_ ? lazy_->blocks_computed() : 0;
 }
 
 bool PyramidSource::stored_level(std::uint32_t level) const noexcept {
@@ -151,7 +184,7 @@ RegionMeta PyramidSource::region_meta(std::uint32_t channel, const Box3& level0_
                                              ": parameter 'channel': " + std::to_string(channel) +
                                              " of " + std::to_string(volume().channels));
   }
-  return pyramid_.query(channel, level0_region);
+  return lazy_ ? lazy_->query(channel, level0_region) : pyramid_.query(channel, level0_region);
 }
 
 std::unique_ptr<PyramidSource> make_dense_pyramid_source(DenseVolume volume, BrickLayout layout,

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -205,6 +206,9 @@ std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const Bric
   d.type = first.bits == 8 ? VoxelType::u8 : first.bits == 16 ? VoxelType::u16 : VoxelType::f32;
   PyramidSourceOptions o;
   o.ranges_from_data = true;
+  // The voxels are read (or mapped) whole at open anyway, so the scan adds at most as much
+  // again, and data-derived ranges beat a type's default range for float data.
+  o.eager_scan_voxels = std::numeric_limits<std::uint64_t>::max();
   return make_dense_pyramid_source(DenseVolume::from_bytes(d, std::move(voxels)), layout, path, o);
 }
 

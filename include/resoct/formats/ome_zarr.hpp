@@ -10,7 +10,10 @@
 /// tolerance 1e-3); every other level is built on demand from the next finer one
 /// (pyramid_source.hpp), and datasets that match no level are not read. Each channel's value
 /// range is its omero window when the file gives one for every channel, else its data's finite
-/// min/max (one pass over the finest level at open, like the metadata pass).
+/// min/max: one pass over the finest level at open when it is within
+/// PyramidSourceOptions::eager_scan_voxels (like the metadata pass), else over the coarsest
+/// stored dataset within that budget, else the type's default range. Above the budget opening
+/// reads metadata objects only and region metadata is computed lazily (docs/formats.md).
 ///
 /// Bricks are cut from chunks on demand (dynamic rebricking, Fogal et al. 2013 §5.2): decoded
 /// chunks live in an LRU cache with a byte budget, so neighbouring bricks cut from one chunk
@@ -64,7 +67,7 @@ class OmeZarrSource final : public PyramidSource {
 /// (naming the file and key), Error(corrupt) naming the file when datasets disagree with the
 /// axes or each other, Error(unsupported) for more than 256 channels or a chunk grid beyond
 /// 131072 chunks per axis, invalid_parameter("timepoint") past the last timepoint, and chunk
-/// decode errors (naming the chunk's location) during the level-0 passes or later reads.
+/// decode errors (naming the chunk's location) during the eager level-0 passes or later reads.
 std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> store,
                                              const BrickLayout& layout = {},
                                              const OmeZarrOptions& options = {});

@@ -7,7 +7,9 @@
 /// brick from level l - 1 with downsample_region() (the project's one downsampling rule, along
 /// exactly the axes BrickHierarchy halves) and the computed brick cores are kept in an LRU cache
 /// with a byte budget, so a coarse level costs one pass over the finer one while it fits.
-/// Region metadata comes from a MetadataPyramid filled by one pass over level 0 at construction.
+/// Region metadata: a level 0 of at most `eager_scan_voxels` voxels (all channels) is scanned at
+/// construction into a MetadataPyramid; a larger one is summarized lazily, block by block on
+/// first need, so opening costs O(metadata) whatever size the input declares (docs/formats.md).
 
 #include <cstdint>
 #include <functional>
@@ -23,6 +25,10 @@
 
 namespace resoct {
 
+namespace detail {
+class LazyMetadata;  // on-demand block summaries (formats_lazy_metadata.hpp)
+}
+
 /// Fills `out` (dense, x fastest) with the voxels of `box` of one channel of one level; the box
 /// lies inside the level. Must be callable from many threads at once.
 using LevelBoxReader =
@@ -34,8 +40,18 @@ struct PyramidSourceOptions {
   /// Edge of a level-0 metadata block (power of two, 4..1024).
   std::uint32_t metadata_block = 16;
   /// Replace every channel's value range by the finite min/max of its level-0 data (an extra
-  /// pass; [lo, lo + 1] for a constant channel, [0, 1] for one without finite voxels).
+  /// pass; [lo, lo + 1] for a constant channel, [0, 1] for one without finite voxels). With lazy
+  /// metadata the pass reads the coarsest stored level instead when that one is within
+  /// eager_scan_voxels, else the ranges stay default_range(type).
   bool ranges_from_data = false;
+  /// Level-0 voxels (times channels) up to which construction scans level 0 eagerly; above it
+  /// region metadata is computed lazily. 0 forces lazy metadata.
+  std::uint64_t eager_scan_voxels = std::uint64_t(64) << 20;
+  /// Lazy metadata: the most unknown metadata blocks one region_meta call reads (as one box);
+  /// a query needing more answers the conservative "unknown" summary instead.
+  std::uint32_t lazy_query_blocks = 64;
+  /// Lazy metadata: cached block summaries (about 48 bytes each); a full cache shard is dropped.
+  std::uint64_t lazy_cache_entries = std::uint64_t(1) << 20;
   /// Threads of the level-0 passes; 0 = hardware concurrency.
   std::uint32_t threads = 0;
 };
@@ -45,11 +61,13 @@ struct PyramidSourceOptions {
 class PyramidSource : public BrickSource {
  public:
   /// `levels[l]` reads hierarchy level l when the input stores it; empty entries and levels
-  /// beyond the vector are built on demand. levels[0] must be set. Runs the level-0 passes.
+  /// beyond the vector are built on demand. levels[0] must be set. Runs the level-0 passes
+  /// when level 0 is within options.eager_scan_voxels.
   /// Throws Error(invalid_argument) for an invalid description, layout, options or a missing
   /// level-0 reader, and whatever the readers throw.
   PyramidSource(VolumeDesc desc, BrickLayout layout, std::vector<LevelBoxReader> levels,
                 std::string name, PyramidSourceOptions options = {});
+  ~PyramidSource() override;
 
   const BrickHierarchy& hierarchy() const override { return hierarchy_; }
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
@@ -62,7 +80,12 @@ class PyramidSource : public BrickSource {
                       std::span<std::byte> out) const;
   /// True when level `level` is read from the input rather than computed.
   bool stored_level(std::uint32_t level) const noexcept;
+  /// The eager metadata pyramid (empty when lazy_metadata()).
   const MetadataPyramid& metadata() const noexcept { return pyramid_; }
+  /// True when region metadata is computed on demand rather than scanned at construction.
+  bool lazy_metadata() const noexcept { return lazy_ != nullptr; }
+  /// Lazy metadata blocks computed so far (0 when eager).
+  std::uint64_t lazy_blocks_computed() const noexcept;
   HostBrickCacheStats cache_stats() const { return cache_->stats(); }
 
  private:
@@ -73,6 +96,7 @@ class PyramidSource : public BrickSource {
   std::vector<LevelBoxReader> levels_;
   std::string name_;
   MetadataPyramid pyramid_;
+  std::unique_ptr<detail::LazyMetadata> lazy_;
   std::unique_ptr<HostBrickCache> cache_;
 };
 
