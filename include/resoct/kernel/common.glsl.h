@@ -48,6 +48,12 @@ inline int bitCount(uint v) {
 #define RESOCT_CONST(T, name, value) inline constexpr T name = value
 #define RESOCT_KERNEL_BEGIN namespace resoct::kernel {
 #define RESOCT_KERNEL_END }
+// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
+#define RESOCT_FRAME_IN const ResoctFrame&
+// Results that decide segment boundaries (slices, lens): `precise` in GLSL so that the device
+// does not contract them into fused multiply-adds (the CPU build never does), keeping iteration
+// counts identical between backends.
+#define RESOCT_PRECISE
 #else
 #define RESOCT_FN
 #define RESOCT_OUT(T) out T
@@ -55,6 +61,8 @@ inline int bitCount(uint v) {
 #define RESOCT_CONST(T, name, value) const T name = value
 #define RESOCT_KERNEL_BEGIN
 #define RESOCT_KERNEL_END
+#define RESOCT_FRAME_IN ResoctFrame
+#define RESOCT_PRECISE precise
 #endif
 
 #endif  // RESOCT_KERNEL_COMMON_GLSL_H

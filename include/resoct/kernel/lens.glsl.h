@@ -18,26 +18,6 @@
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 
-// Results that decide where segments start and end: `precise` in GLSL so that the device does not
-// contract them into fused multiply-adds (the CPU build never does), keeping segment boundaries,
-// and hence iteration counts, identical between backends.
-#ifndef RESOCT_PRECISE
-#ifdef __cplusplus
-#define RESOCT_PRECISE
-#else
-#define RESOCT_PRECISE precise
-#endif
-#endif
-
-// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
-#ifndef RESOCT_FRAME_IN
-#ifdef __cplusplus
-#define RESOCT_FRAME_IN const ResoctFrame&
-#else
-#define RESOCT_FRAME_IN ResoctFrame
-#endif
-#endif
-
 RESOCT_KERNEL_BEGIN
 
 /// Row i of the lens matrix.

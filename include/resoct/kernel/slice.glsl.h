@@ -28,24 +28,6 @@
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
-// `precise` in GLSL for the plane hit, which decides segment boundaries (see lens.glsl.h).
-#ifndef RESOCT_PRECISE
-#ifdef __cplusplus
-#define RESOCT_PRECISE
-#else
-#define RESOCT_PRECISE precise
-#endif
-#endif
-
-// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
-#ifndef RESOCT_FRAME_IN
-#ifdef __cplusplus
-#define RESOCT_FRAME_IN const ResoctFrame&
-#else
-#define RESOCT_FRAME_IN ResoctFrame
-#endif
-#endif
-
 RESOCT_KERNEL_BEGIN
 
 /// Largest footprint stretch 1 / |cos θ| of a grazing plane (beyond it the plane is edge-on).
