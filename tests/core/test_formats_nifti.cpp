@@ -19,6 +19,7 @@
 #include "resoct/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
+#include "support/level0_values.hpp"
 
 using namespace resoct;
 using test::TempDir;
@@ -87,28 +88,6 @@ std::vector<std::uint8_t> gzip(const std::vector<std::uint8_t>& in) {
   return out;
 }
 
-std::vector<double> level0(const BrickSource& s, std::uint32_t channel) {
-  const auto& p = dynamic_cast<const PyramidSource&>(s);
-  const VolumeDesc& d = s.volume();
-  std::vector<std::byte> bytes(d.voxel_count() * voxel_size(d.type));
-  p.read_level_box(0, channel, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, bytes);
-  std::vector<double> v;
-  for (std::size_t i = 0; i < d.voxel_count(); ++i) {
-    if (d.type == VoxelType::u8) v.push_back(double(std::uint8_t(bytes[i])));
-    if (d.type == VoxelType::u16) {
-      std::uint16_t x;
-      std::memcpy(&x, bytes.data() + 2 * i, 2);
-      v.push_back(x);
-    }
-    if (d.type == VoxelType::f32) {
-      float x;
-      std::memcpy(&x, bytes.data() + 4 * i, 4);
-      v.push_back(x);
-    }
-  }
-  return v;
-}
-
 TEST(Nifti, EveryDatatypeBothByteOrdersPlainAndGzip) {
   TempDir dir;
   struct T {
@@ -144,7 +123,7 @@ TEST(Nifti, EveryDatatypeBothByteOrdersPlainAndGzip) {
         EXPECT_EQ(src->volume().extent, glm::u64vec3(5, 4, 3));
         EXPECT_NEAR(src->volume().spacing.x, 0.7, 1e-6);
         EXPECT_NEAR(src->volume().spacing.z, 2.5, 1e-6);
-        EXPECT_EQ(level0(*src, 0), want);
+        EXPECT_EQ(level0_values(*src, 0), want);
         double lo = 1e300, hi = -1e300;
         for (double v : want) lo = std::min(lo, v), hi = std::max(hi, v);
         EXPECT_EQ(src->volume().range(0), (ValueRange{lo, hi}));
@@ -172,7 +151,7 @@ TEST(Nifti, ScalingSformSpacingAndVolumesAsChannels) {
   EXPECT_EQ(src->volume().channels, 3u);
   EXPECT_EQ(src->volume().spacing, glm::dvec3(2, 3, 4));
   for (std::uint32_t c = 0; c < 3; ++c) {
-    const auto v = level0(*src, c);
+    const auto v = level0_values(*src, c);
     for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(v[i], 0.5 * double((c * 12 + i) * 7) - 10.0);
   }
 }
@@ -268,7 +247,7 @@ TEST(NiftiRealData, Colin27T1MatchesTheFileVoxelForVoxel) {
   EXPECT_EQ(d.type, VoxelType::u8);
   const auto raw = gunzip(path);
   ASSERT_GE(raw.size(), 352u + 301u * 370u * 316u);
-  const auto v = level0(*src, 0);
+  const auto v = level0_values(*src, 0);
   std::size_t differ = 0, nonzero = 0;
   for (std::size_t i = 0; i < v.size(); ++i) {
     differ += v[i] != double(raw[352 + i]);
@@ -320,7 +299,7 @@ TEST(NiftiRealData, Int16AtlasWithExtensionsAndFloatTemplate) {
   EXPECT_EQ(src->volume().type, VoxelType::f32);
   EXPECT_EQ(src->volume().extent, glm::u64vec3(168, 206, 128));
   const auto raw = gunzip(path);
-  const auto v = level0(*src, 0);
+  const auto v = level0_values(*src, 0);
   std::size_t differ = 0;
   for (std::size_t i = 0; i < v.size(); ++i) {
     std::int16_t s;

@@ -17,6 +17,7 @@
 #include "resoct/formats/pyramid_source.hpp"
 #include "resoct/open_source.hpp"
 #include "support/expect_error.hpp"
+#include "support/level0_values.hpp"
 
 using namespace resoct;
 using test::TempDir;
@@ -67,28 +68,6 @@ double sample_value(const std::string& type, std::size_t i) {
   return double(i) * 0.125 - 3.0;
 }
 
-std::vector<double> level0(const BrickSource& s, std::uint32_t channel) {
-  const auto& p = dynamic_cast<const PyramidSource&>(s);
-  const VolumeDesc& d = s.volume();
-  std::vector<std::byte> bytes(d.voxel_count() * voxel_size(d.type));
-  p.read_level_box(0, channel, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, bytes);
-  std::vector<double> v;
-  for (std::size_t i = 0; i < d.voxel_count(); ++i) {
-    if (d.type == VoxelType::u8) v.push_back(double(std::uint8_t(bytes[i])));
-    if (d.type == VoxelType::u16) {
-      std::uint16_t x;
-      std::memcpy(&x, bytes.data() + 2 * i, 2);
-      v.push_back(x);
-    }
-    if (d.type == VoxelType::f32) {
-      float x;
-      std::memcpy(&x, bytes.data() + 4 * i, 4);
-      v.push_back(x);
-    }
-  }
-  return v;
-}
-
 TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
   TempDir dir;
   const glm::u64vec3 e(6, 5, 4);
@@ -125,7 +104,7 @@ TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
           EXPECT_EQ(d.type, type == "uchar"    ? VoxelType::u8
                             : type == "ushort" ? VoxelType::u16
                                                : VoxelType::f32);
-          const auto v = level0(*src, 0);
+          const auto v = level0_values(*src, 0);
           for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(v[i], sample_value(type, i)) << i;
         }
       }
@@ -149,7 +128,7 @@ TEST(Nrrd, ChannelAxesSpaceDirectionsAndSkips) {
   EXPECT_EQ(vec->volume().extent, glm::u64vec3(4, 3, 2));
   EXPECT_EQ(vec->volume().spacing, glm::dvec3(1.5, 2, 3));
   for (std::uint32_t c = 0; c < 3; ++c) {
-    const auto v = level0(*vec, c);
+    const auto v = level0_values(*vec, c);
     for (std::size_t i = 0; i < 24; ++i) ASSERT_EQ(v[i], double(i * 3 + c));
   }
   // 4-D with the last axis 2 channels one after another; a detached file with line and byte
@@ -164,7 +143,7 @@ TEST(Nrrd, ChannelAxesSpaceDirectionsAndSkips) {
   const auto t = open_source(dir.file("t.nhdr"), BrickLayout{glm::uvec3(4), 1});
   EXPECT_EQ(t->volume().channels, 2u);
   for (std::uint32_t c = 0; c < 2; ++c) {
-    const auto v = level0(*t, c);
+    const auto v = level0_values(*t, c);
     for (std::size_t i = 0; i < 8; ++i) ASSERT_EQ(v[i], double((c * 8 + i) * 1000));
   }
   // byte skip -1: the data are the last bytes of the file.
@@ -174,7 +153,7 @@ TEST(Nrrd, ChannelAxesSpaceDirectionsAndSkips) {
   test::write_bytes(dir.file("tail.nrrd"), tail);
   const auto s2 = open_source(dir.file("tail.nrrd"), BrickLayout{glm::uvec3(4), 1});
   EXPECT_EQ(s2->volume().extent, glm::u64vec3(3, 2, 1));
-  EXPECT_EQ(level0(*s2, 0), (std::vector<double>{'4', '5', '6', '7', '8', '9'}));
+  EXPECT_EQ(level0_values(*s2, 0), (std::vector<double>{'4', '5', '6', '7', '8', '9'}));
 }
 
 TEST(Nrrd, MalformedHeadersAndFiles) {

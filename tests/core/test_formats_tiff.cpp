@@ -15,6 +15,7 @@
 #include "resoct/formats/tiff_stack.hpp"
 #include "resoct/open_source.hpp"
 #include "support/expect_error.hpp"
+#include "support/level0_values.hpp"
 #include "support/tiff_writer.hpp"
 
 using namespace resoct;
@@ -29,28 +30,6 @@ std::vector<double> values(const Page& p, std::uint32_t z) {
   for (std::size_t i = 0; i < v.size(); ++i) {
     const double top = p.bits == 8 ? 256.0 : 65536.0;
     v[i] = p.format == 3 ? double(i) * 0.5 - 2.25 + z : std::fmod(double(i * 37 + z * 101), top);
-  }
-  return v;
-}
-
-std::vector<double> level0(const BrickSource& s) {
-  const auto& p = dynamic_cast<const PyramidSource&>(s);
-  const VolumeDesc& d = s.volume();
-  std::vector<std::byte> bytes(d.voxel_count() * voxel_size(d.type));
-  p.read_level_box(0, 0, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, bytes);
-  std::vector<double> v;
-  for (std::size_t i = 0; i < d.voxel_count(); ++i) {
-    if (d.type == VoxelType::u8) v.push_back(double(std::uint8_t(bytes[i])));
-    if (d.type == VoxelType::u16) {
-      std::uint16_t x;
-      std::memcpy(&x, bytes.data() + 2 * i, 2);
-      v.push_back(x);
-    }
-    if (d.type == VoxelType::f32) {
-      float x;
-      std::memcpy(&x, bytes.data() + 4 * i, 4);
-      v.push_back(x);
-    }
   }
   return v;
 }
@@ -85,7 +64,7 @@ TEST(TiffStack, MultiPageFilesEveryTypeLayoutAndByteOrder) {
         const auto src = open_source(dir.file("s.tif"), BrickLayout{glm::uvec3(4), 1});
         EXPECT_EQ(src->volume().type, k.type);
         EXPECT_EQ(src->volume().extent, glm::u64vec3(p.width, p.height, 3));
-        EXPECT_EQ(level0(*src), want);
+        EXPECT_EQ(level0_values(*src, 0), want);
       }
     }
   }
@@ -108,7 +87,7 @@ TEST(TiffStack, DirectoryOfSinglePageFilesInNameOrder) {
   EXPECT_EQ(detect_source_kind(dir.path().string()), SourceKind::tiff);
   const auto src = open_source(dir.path().string(), BrickLayout{glm::uvec3(4), 1});
   EXPECT_EQ(src->volume().extent, glm::u64vec3(7, 5, 4));
-  EXPECT_EQ(level0(*src), want);
+  EXPECT_EQ(level0_values(*src, 0), want);
 }
 
 TEST(TiffStack, UnsupportedAndDamagedFiles) {
