@@ -31,11 +31,16 @@ std::vector<T> words_of(const std::vector<std::byte>& bytes) {
 // Compares every device array with the renderer's host state; returns the occupied slots.
 std::size_t expect_device_matches_host(const Renderer& r, const vk::VulkanBackend& gpu,
                                        const std::string& what) {
-  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)),
-            r.page_table().entries())
+  // The device pool: the host's used prefix, UNMAPPED beyond it.
+  std::vector<std::uint32_t> pool = r.page_table().pool();
+  pool.resize(std::size_t(r.page_table().pool_block_count()) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
+              0u);
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pool) << what;
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory)),
+            r.page_table().directory())
       << what;
-  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::page_offsets)),
-            r.page_table().table_offsets())
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory_offsets)),
+            r.page_table().directory_offsets())
       << what;
   const auto& words = r.octree().words();
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)),
