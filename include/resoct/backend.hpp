@@ -40,14 +40,14 @@ RenderMode parse_render_mode(std::string_view s);
 /// Sizes of the device state, fixed until the next configure().
 struct BackendConfig {
   VoxelType voxel_type = VoxelType::u8;
-  glm::uvec3 padded_brick{34};     ///< voxels per cache slot per axis (core + 2 halo)
-  std::uint32_t cache_slots = 0;   ///< bricks the device cache holds
+  glm::uvec3 padded_brick{34};    ///< voxels per cache slot per axis (core + 2 halo)
+  std::uint32_t cache_slots = 0;  ///< bricks the device cache holds
   /// Blocks of the page pool (PageTable::pool_block_count(), block 0 included), each
   /// RESOCT_PAGE_BLOCK_ENTRIES words.
   std::uint32_t page_pool_blocks = 1;
   std::uint32_t directory_entries = 0;  ///< words of the page directory (PageTable::directory())
   std::uint32_t page_tables = 0;        ///< (slot, level) tables (PageTable::table_count())
-  std::uint64_t node_words = 0;    ///< words of the octree (ResidencyOctree::words())
+  std::uint64_t node_words = 0;         ///< words of the octree (ResidencyOctree::words())
   std::uint32_t brick_request_capacity = 1u << 16;  ///< device request set sizes
   std::uint32_t node_request_capacity = 1u << 14;
   /// Brick bytes the frame loop uploads per frame at most (its UploadBudget); 0 = unknown. A
@@ -112,7 +112,7 @@ struct FrameResult {
   /// Device request keys (PageTable::device_key) + hits. Keys name pool blocks, not levels, so
   /// every brick request carries level 0 (the loader orders loads by the decoded brick).
   std::vector<Request> brick_requests;
-  std::vector<Request> node_requests;   ///< octree node indices + hits
+  std::vector<Request> node_requests;           ///< octree node indices + hits
   std::vector<std::uint32_t> used_cache_slots;  ///< distinct cache slots sampled this frame
   BackendStats stats;
 };

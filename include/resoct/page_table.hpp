@@ -50,10 +50,10 @@ struct BlockMiss {
 
 /// Result of virtual address translation (thesis Eq. 5.1-5.3 with the partial-brick fix).
 struct PageLookup {
-  std::uint32_t entry = 0;       ///< the entry word (see kernel/page_entry.glsl.h)
-  glm::uvec3 brick{0};           ///< brick coordinates at the level
-  glm::uvec3 voxel{0};           ///< level voxel, clamped to the level extent
-  glm::uvec3 padded_offset{0};   ///< voxel within the padded brick: core offset + halo
+  std::uint32_t entry = 0;      ///< the entry word (see kernel/page_entry.glsl.h)
+  glm::uvec3 brick{0};          ///< brick coordinates at the level
+  glm::uvec3 voxel{0};          ///< level voxel, clamped to the level extent
+  glm::uvec3 padded_offset{0};  ///< voxel within the padded brick: core offset + halo
 
   bool mapped() const noexcept { return kernel::resoct_page_is_mapped(entry); }
   /// Cache slot of a MAPPED entry, nullopt otherwise.
@@ -183,9 +183,9 @@ class PageTable {
   std::uint64_t clock_ = 0;
   std::vector<std::uint32_t> directory_;
   std::vector<std::uint32_t> dir_offsets_;
-  std::vector<std::uint32_t> pool_;    // grows block by block up to pool_block_count()
-  std::vector<BlockInfo> blocks_;      // parallel to pool_ blocks
-  std::vector<std::uint32_t> free_;    // freed blocks below the high-water mark
+  std::vector<std::uint32_t> pool_;  // grows block by block up to pool_block_count()
+  std::vector<BlockInfo> blocks_;    // parallel to pool_ blocks
+  std::vector<std::uint32_t> free_;  // freed blocks below the high-water mark
   std::set<std::pair<std::uint64_t, std::uint32_t>> reclaimable_;  // (stamp, block), no MAPPED
   std::vector<std::uint64_t> pool_dirty_bits_;  // one bit per pool word: in pool_dirty_list_
   std::vector<std::uint32_t> pool_dirty_list_;

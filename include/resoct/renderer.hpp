@@ -176,9 +176,9 @@ class Renderer {
   std::shared_ptr<SharedEye> host_camera_ = std::make_shared<SharedEye>();
   CameraPredictor predictor_;
   std::uint64_t frame_ = 0;
-  bool send_full_ = true;                     // next update carries full arrays
-  std::vector<LoadedBrick> staged_;           // loaded, waiting for budget or a free slot
-  std::vector<std::uint32_t> pending_nodes_;  // node requests to answer next frame
+  bool send_full_ = true;                      // next update carries full arrays
+  std::vector<LoadedBrick> staged_;            // loaded, waiting for budget or a free slot
+  std::vector<std::uint32_t> pending_nodes_;   // node requests to answer next frame
   std::vector<std::uint32_t> pending_blocks_;  // page-table blocks to allocate next frame
   // Requested bricks -> frame of their first request in an unbroken run of frames (ageing).
   std::unordered_map<BrickKey, std::uint64_t> waiting_since_;

@@ -75,8 +75,7 @@ void CpuBackend::configure(const BackendConfig& config) {
   resize_zeroed(pages_, std::size_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
                 "page pool");
   resize_zeroed(directory_, config.directory_entries, "page directory");
-  resize_zeroed(directory_offsets_, std::size_t(config.page_tables) + 1u,
-                "page directory offsets");
+  resize_zeroed(directory_offsets_, std::size_t(config.page_tables) + 1u, "page directory offsets");
   resize_zeroed(nodes_, std::size_t(config.node_words), "octree");
   used_words_ = (std::size_t(config.cache_slots) + 63u) / 64u;
   used_bits_ =
@@ -110,17 +109,15 @@ void CpuBackend::update(const FrameUpdate& u) {
                                             " words, at most " + std::to_string(pages_.size()));
     }
     if (u.all_directory.size() != directory_.size()) {
-      throw invalid_parameter("update", "full page directory of " +
-                                            std::to_string(u.all_directory.size()) +
-                                            " entries, expected " +
-                                            std::to_string(directory_.size()));
+      throw invalid_parameter("update",
+                              "full page directory of " + std::to_string(u.all_directory.size()) +
+                                  " entries, expected " + std::to_string(directory_.size()));
     }
     if (u.directory_offsets.size() != directory_offsets_.size()) {
       throw invalid_parameter("update", "directory_offsets has the wrong size");
     }
     for (std::uint32_t o : u.directory_offsets) {
-      if (o > directory_.size())
-        throw invalid_parameter("update", "directory offset out of range");
+      if (o > directory_.size()) throw invalid_parameter("update", "directory offset out of range");
     }
     for (std::uint32_t b : u.all_directory) {
       if (b >= pool_blocks) throw invalid_parameter("update", "directory names no pool block");

@@ -38,7 +38,7 @@ enum Binding : std::uint32_t {
   b_levels,
   b_depths,
   b_nodes,
-  b_pages,           // the page pool
+  b_pages,  // the page pool
   b_directory_offsets,
   b_tf,
   b_cache,

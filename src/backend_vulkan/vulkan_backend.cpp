@@ -161,8 +161,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
     const std::uint32_t n = std::min(config.cache_slots - first, slots_per_chunk);
     m.ensure(cache_binding(c), (std::uint64_t(n) * brick_bytes + 3) & ~3ull, "brick cache");
   }
-  const Binding order[] = {b_pages,          b_directory_offsets, b_nodes,        b_brick_requests,
-                           b_node_requests,  b_used,              b_directory};
+  const Binding order[] = {b_pages, b_directory_offsets, b_nodes, b_brick_requests, b_node_requests,
+                           b_used,  b_directory};
   for (std::size_t i = 0; i < sizes.size(); ++i)
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");

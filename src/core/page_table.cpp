@@ -61,9 +61,10 @@ std::uint64_t PageTable::block_count(const BrickHierarchy& hierarchy, std::uint3
   return per_slot * slots;
 }
 
-PageTable::PageTable(const BrickHierarchy& hierarchy, std::uint32_t slots,
-                     std::uint32_t max_blocks)
-    : hierarchy_(hierarchy), slots_(slots), levels_(hierarchy.level_count()),
+PageTable::PageTable(const BrickHierarchy& hierarchy, std::uint32_t slots, std::uint32_t max_blocks)
+    : hierarchy_(hierarchy),
+      slots_(slots),
+      levels_(hierarchy.level_count()),
       max_blocks_(max_blocks) {
   if (slots == 0) throw invalid_parameter("slots", "at least one visible channel slot is needed");
   if (max_blocks == 0) throw invalid_parameter("max_blocks", "at least one pool block is needed");
@@ -228,8 +229,8 @@ std::uint32_t PageTable::take_block() {
 void PageTable::allocate_block(std::uint32_t directory_index) {
   if (directory_index >= directory_.size()) {
     throw Error(ErrorCode::out_of_range, "directory index " + std::to_string(directory_index) +
-                                             " out of range (" +
-                                             std::to_string(directory_.size()) + " entries)");
+                                             " out of range (" + std::to_string(directory_.size()) +
+                                             " entries)");
   }
   if (directory_[directory_index] != 0u) return;
   const std::uint32_t block = take_block();
@@ -335,8 +336,7 @@ std::optional<PageAddress> PageTable::decode_device_key(std::uint32_t key) const
   const std::uint32_t in = k::resoct_request_key_in_block(key);
   const glm::uvec3 local(in & 15u, (in >> 4u) & 15u, in >> 8u);
   a.brick = blk * 16u + local;
-  if (a.brick.x >= bricks.x || a.brick.y >= bricks.y || a.brick.z >= bricks.z)
-    return std::nullopt;
+  if (a.brick.x >= bricks.x || a.brick.y >= bricks.y || a.brick.z >= bricks.z) return std::nullopt;
   return a;
 }
 

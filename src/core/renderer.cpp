@@ -51,8 +51,8 @@ std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
   if (blocks < total && blocks <= cache_slots) {
     throw invalid_parameter("page_pool_blocks",
                             std::to_string(blocks) + " blocks must exceed the device cache's " +
-                                std::to_string(cache_slots) +
-                                " slots (or cover all " + std::to_string(total) +
+                                std::to_string(cache_slots) + " slots (or cover all " +
+                                std::to_string(total) +
                                 " blocks); raise it or lower device_cache_bytes");
   }
   return std::uint32_t(blocks);

@@ -127,7 +127,7 @@ TEST(ChannelMap, ResolvesADrainedBatchAndCountsStaleRequests) {
   rs.insert(pt.device_key(miss0), 1);  // block misses: slot 0 valid, slot 1 remapped below
   rs.insert(pt.device_key(miss1), 1);
   rs.insert(k::resoct_request_key_brick(pt.pool_block_count(), 0));  // garbage from the device
-  rs.insert(k::resoct_request_key_block_miss(0x7FFFFFF0u));           // garbage as well
+  rs.insert(k::resoct_request_key_block_miss(0x7FFFFFF0u));          // garbage as well
   cm.assign(1, 2, pt);  // slot 1 remapped after recording
   const RequestBatch batch = rs.drain([&](std::uint32_t key) {
     const auto d = pt.decode_device_key(key);

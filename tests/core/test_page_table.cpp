@@ -308,9 +308,9 @@ TEST(PageTable, DeviceKeysRoundTripAndForeignKeysAreRejected) {
   EXPECT_FALSE(pt.decode_device_key(k::resoct_request_key_brick(0, 0)).has_value());
   EXPECT_FALSE(
       pt.decode_device_key(k::resoct_request_key_brick(pt.pool_block_count(), 0)).has_value());
-  EXPECT_FALSE(pt.decode_block_miss(k::resoct_request_key_block_miss(
-                                        std::uint32_t(pt.directory().size())))
-                   .has_value());
+  EXPECT_FALSE(
+      pt.decode_block_miss(k::resoct_request_key_block_miss(std::uint32_t(pt.directory().size())))
+          .has_value());
   EXPECT_RESOCT_ERROR(pt.device_key(PageAddress{0, 0, {100, 0, 0}}), ErrorCode::out_of_range,
                       "outside level");
 }

@@ -37,8 +37,8 @@ PageAddress addr_of(const Addr& t) {
 }
 
 // Brute-force block identity: (slot, level, brick / 16).
-using BlockId = std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t,
-                           std::uint32_t>;
+using BlockId =
+    std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>;
 BlockId block_of(const PageAddress& a) {
   return {a.slot, a.level, a.brick.x / 16u, a.brick.y / 16u, a.brick.z / 16u};
 }
@@ -292,7 +292,8 @@ TEST(PageTableSparse, Volume65536CubedNeedsOnlyItsDirectoryAndUsedBlocks) {
   PageTable pt(h, 4, 64);
   std::uint64_t expect_dir = 0;
   for (std::uint32_t l = 0; l < h.level_count(); ++l) {
-    const glm::u64vec3 n = (glm::u64vec3(h.level(l).bricks) + std::uint64_t(15)) / std::uint64_t(16);
+    const glm::u64vec3 n =
+        (glm::u64vec3(h.level(l).bricks) + std::uint64_t(15)) / std::uint64_t(16);
     expect_dir += n.x * n.y * n.z;
   }
   EXPECT_EQ(pt.directory().size(), expect_dir * 4u);

@@ -101,7 +101,8 @@ void RecordingBackend::want(const PageTable& table, std::span<const PageAddress>
     const std::uint32_t d = table.directory_index(a);
     const std::uint32_t block = directory_.at(d);
     const std::uint32_t in = kernel::resoct_page_in_block_index(a.brick);
-    const std::uint32_t entry = pages_.at(std::size_t(block) * kernel::RESOCT_PAGE_BLOCK_ENTRIES + in);
+    const std::uint32_t entry =
+        pages_.at(std::size_t(block) * kernel::RESOCT_PAGE_BLOCK_ENTRIES + in);
     if (kernel::resoct_page_is_mapped(entry)) {
       result.used_cache_slots.push_back(kernel::resoct_page_cache_slot(entry));
     } else if (kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED) {

@@ -37,7 +37,8 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
 
   const std::size_t brick_bytes = 5u * 3u * 7u * voxel_size(type);
   std::vector<std::byte> cache(cfg.cache_slots * brick_bytes, std::byte{0});
-  std::vector<std::uint32_t> pages(cfg.page_pool_blocks * 4096u, 0), offsets(cfg.page_tables + 1u, 0);
+  std::vector<std::uint32_t> pages(cfg.page_pool_blocks * 4096u, 0),
+      offsets(cfg.page_tables + 1u, 0);
   std::vector<std::uint32_t> dir(cfg.directory_entries, 0);
   std::vector<std::uint32_t> nodes(cfg.node_words, 0);
   // configure() leaves every array zero.

@@ -35,7 +35,7 @@ RESOCT_FN uvec3 resoct_brick_at(ResoctLevelInfo L, uvec3 brick_size, ivec3 cell)
 
 /// Global directory index of the block holding a brick of (slot, level).
 RESOCT_FN uint resoct_page_directory_index(uint slot, uint level, uint level_count,
-                                          ResoctLevelInfo L, uvec3 brick) {
+                                           ResoctLevelInfo L, uvec3 brick) {
   return resoct_read_directory_offset(resoct_request_table_id(slot, level, level_count)) +
          resoct_page_block_index(brick, uvec3(L.bricks_x, L.bricks_y, L.bricks_z));
 }
@@ -43,7 +43,8 @@ RESOCT_FN uint resoct_page_directory_index(uint slot, uint level, uint level_cou
 /// The page entry of a brick of (slot, level): directory, then pool (block 0 reads UNMAPPED).
 RESOCT_FN uint resoct_page_entry_of(uint slot, uint level, uint level_count, ResoctLevelInfo L,
                                     uvec3 brick) {
-  uint block = resoct_read_directory(resoct_page_directory_index(slot, level, level_count, L, brick));
+  uint block =
+      resoct_read_directory(resoct_page_directory_index(slot, level, level_count, L, brick));
   return resoct_read_page((block << RESOCT_PAGE_BLOCK_ENTRIES_LOG2) |
                           resoct_page_in_block_index(brick));
 }
