@@ -17,6 +17,7 @@
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
+#include "support/expect_error.hpp"
 #include "support/resident_scene.hpp"
 
 using namespace resoct;
@@ -167,6 +168,28 @@ TEST(CpuSparsePages, Volume65536CubedConvergesAtADistantViewWithABoundedPool) {
   std::size_t shown = 0;
   for (const glm::vec4& px : rep.last.image.pixels()) shown += px.a > 0.01f ? 1u : 0u;
   EXPECT_GT(shown, 0u);
+}
+
+TEST(CpuSparsePages, PoolSizeIsCheckedAtConstruction) {
+  std::shared_ptr<const BrickSource> source =
+      make_procedural_source("procedural:sphere:512x512x512", BrickLayout{glm::uvec3(4), 1});
+  RendererOptions o = options(glm::uvec3(16));
+  const std::uint64_t slot_bytes =
+      source->hierarchy().layout().padded_voxels() * voxel_size(source->volume().type);
+  o.device_cache_bytes = 100 * slot_bytes;
+  // Not more blocks than cache slots (and fewer than the 589 blocks): no victim guaranteed.
+  o.page_pool_blocks = 100;
+  EXPECT_RESOCT_ERROR(Renderer(source, o), ErrorCode::invalid_argument, "page_pool_blocks");
+  o.page_pool_blocks = kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS;
+  EXPECT_RESOCT_ERROR(Renderer(source, o), ErrorCode::invalid_argument, "page_pool_blocks");
+  // A pool covering every block needs no headroom; the default is clamped to the blocks.
+  o.device_cache_bytes = 1000 * slot_bytes;
+  o.page_pool_blocks = 589;
+  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 589u);
+  o.page_pool_blocks = 0;
+  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 589u);
+  o.device_cache_bytes = 100 * slot_bytes;
+  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 164u);  // 100 + max(50, 64)
 }
 
 }  // namespace
