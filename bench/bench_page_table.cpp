@@ -13,7 +13,9 @@ void BM_PageTableTranslate(benchmark::State& state) {
   resoct::VolumeDesc v;
   v.extent = {1024, 1024, 795};
   const resoct::BrickHierarchy h(v, resoct::BrickLayout{glm::uvec3(32), 1});
-  resoct::PageTable pt(h, 4);
+  resoct::PageTable pt(h, 4, std::uint32_t(resoct::PageTable::block_count(h, 4)));
+  // Every block allocated: translate() reads a real pool block, as it does for resident data.
+  for (std::uint32_t d = 0; d < pt.directory().size(); ++d) pt.allocate_block(d);
   std::mt19937 gen(9);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   struct Query {

@@ -139,7 +139,7 @@ void BM_LensPaging(benchmark::State& state) {
     benchmark::DoNotOptimize(rep.last.image.pixels().data());
     frames = rep.frames;
     paged = 0;
-    for (std::uint32_t e : renderer.page_table().entries()) {
+    for (std::uint32_t e : renderer.page_table().pool()) {
       if (kernel::resoct_page_state(e) != kernel::RESOCT_PAGE_STATE_UNMAPPED) ++paged;
     }
   }

@@ -58,7 +58,10 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
   const VolumeDesc& vol = h.volume();
   rig->layout = OctreeLayout(vol.extent, glm::uvec3(16));
   rig->channels = std::make_unique<ChannelMap>(n, vol.channels);
-  rig->pages = std::make_unique<PageTable>(h, n);
+  const std::uint64_t blocks = PageTable::block_count(h, n);
+  rig->pages = std::make_unique<PageTable>(h, n, std::uint32_t(blocks));
+  // Every block allocated, as for data that is resident everywhere.
+  for (std::uint32_t d = 0; d < blocks; ++d) rig->pages->allocate_block(d);
   for (std::uint32_t s = 0; s < n; ++s) rig->channels->assign(s, s, *rig->pages);
   PageTable* pages = rig->pages.get();
   rig->octree = std::make_unique<
@@ -112,7 +115,8 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
   config.voxel_type = vol.type;
   config.padded_brick = h.layout().padded_size();
   config.cache_slots = std::max<std::uint32_t>(std::uint32_t(slots.size()), 1u);
-  config.page_entries = std::uint32_t(rig->pages->entries().size());
+  config.page_pool_blocks = rig->pages->pool_block_count();
+  config.directory_entries = std::uint32_t(rig->pages->directory().size());
   config.page_tables = rig->pages->table_count();
   config.node_words = rig->octree->words().size();
   rig->backend->configure(config);
@@ -124,8 +128,9 @@ std::unique_ptr<Rig> make_rig(const std::string& spec, std::uint32_t n) {
   FrameUpdate u;
   u.bricks = uploads;
   u.pages_full = true;
-  u.all_pages = rig->pages->entries();
-  u.page_table_offsets = rig->pages->table_offsets();
+  u.all_pages = rig->pages->pool();
+  u.all_directory = rig->pages->directory();
+  u.directory_offsets = rig->pages->directory_offsets();
   u.nodes_full = true;
   u.all_nodes = rig->octree->words();
   rig->backend->update(u);

@@ -45,6 +45,14 @@ ConvergeRun converge(std::shared_ptr<const BrickSource> source, const Scene& sce
   }
   run.ms_total = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   run.converged = report.converged;
+  {
+    const PageTable& pt = renderer.page_table();
+    run.page_blocks = pt.allocated_blocks();
+    run.page_pool_blocks = pt.pool_block_count();
+    run.page_table_bytes =
+        4u * (std::uint64_t(pt.directory().size()) +
+              (std::uint64_t(pt.allocated_blocks()) + 1u) * kernel::RESOCT_PAGE_BLOCK_ENTRIES);
+  }
   run.working_set_bricks = report.stats.working_set_bricks;
   run.working_set_bytes = report.stats.working_set_bytes;
   const BrickLoaderStats loads = renderer.loader().stats();

@@ -30,8 +30,11 @@ struct ConvergeRun {
   std::uint64_t working_set_bytes = 0;
   std::uint64_t brick_bytes = 0;  ///< padded bytes of one brick
   std::uint32_t cache_slots = 0;
-  FrameStats last;  ///< statistics of the last frame
-  Image image;      ///< the last frame
+  std::uint32_t page_blocks = 0;       ///< page-table pool blocks allocated after the run
+  std::uint32_t page_pool_blocks = 0;  ///< pool capacity (device blocks, block 0 included)
+  std::uint64_t page_table_bytes = 0;  ///< host directory + allocated pool blocks
+  FrameStats last;                     ///< statistics of the last frame
+  Image image;                         ///< the last frame
 };
 
 /// A scene over dataset channels 0..visible-1 with the rig's transfer functions (duplicate_tf

@@ -40,11 +40,14 @@ RenderMode parse_render_mode(std::string_view s);
 /// Sizes of the device state, fixed until the next configure().
 struct BackendConfig {
   VoxelType voxel_type = VoxelType::u8;
-  glm::uvec3 padded_brick{34};     ///< voxels per cache slot per axis (core + 2 halo)
-  std::uint32_t cache_slots = 0;   ///< bricks the device cache holds
-  std::uint32_t page_entries = 0;  ///< words of the page table (PageTable::entries())
-  std::uint32_t page_tables = 0;   ///< (slot, level) tables (PageTable::table_count())
-  std::uint64_t node_words = 0;    ///< words of the octree (ResidencyOctree::words())
+  glm::uvec3 padded_brick{34};    ///< voxels per cache slot per axis (core + 2 halo)
+  std::uint32_t cache_slots = 0;  ///< bricks the device cache holds
+  /// Blocks of the page pool (PageTable::pool_block_count(), block 0 included), each
+  /// RESOCT_PAGE_BLOCK_ENTRIES words.
+  std::uint32_t page_pool_blocks = 1;
+  std::uint32_t directory_entries = 0;  ///< words of the page directory (PageTable::directory())
+  std::uint32_t page_tables = 0;        ///< (slot, level) tables (PageTable::table_count())
+  std::uint64_t node_words = 0;         ///< words of the octree (ResidencyOctree::words())
   std::uint32_t brick_request_capacity = 1u << 16;  ///< device request set sizes
   std::uint32_t node_request_capacity = 1u << 14;
   /// Brick bytes the frame loop uploads per frame at most (its UploadBudget); 0 = unknown. A
@@ -62,10 +65,14 @@ struct BrickUpload {
 /// complete array and the delta list is empty (e.g. after configure() or a slot remap).
 struct FrameUpdate {
   std::span<const BrickUpload> bricks;
-  std::span<const PageDelta> page_deltas;
+  std::span<const PageDelta> page_deltas;       ///< pool words: index = block * 4096 + entry
+  std::span<const PageDelta> directory_deltas;  ///< directory words (values < page_pool_blocks)
   bool pages_full = false;
+  /// With pages_full: a prefix of the pool (PageTable::pool(); the rest reads UNMAPPED), the
+  /// whole directory and the table_count + 1 directory offsets.
   std::span<const std::uint32_t> all_pages;
-  std::span<const std::uint32_t> page_table_offsets;  ///< per (slot, level) table; sent when full
+  std::span<const std::uint32_t> all_directory;
+  std::span<const std::uint32_t> directory_offsets;
   std::span<const OctreeWordDelta> node_deltas;
   bool nodes_full = false;
   std::span<const std::uint32_t> all_nodes;
@@ -102,8 +109,10 @@ struct BackendStats {
 /// What render() returns.
 struct FrameResult {
   Image image;  ///< RGBA over the background, stored straight (docs/rendering.md "Compositing")
-  std::vector<Request> brick_requests;  ///< device request keys (PageTable::device_key) + hits
-  std::vector<Request> node_requests;   ///< octree node indices + hits
+  /// Device request keys (PageTable::device_key) + hits. Keys name pool blocks, not levels, so
+  /// every brick request carries level 0 (the loader orders loads by the decoded brick).
+  std::vector<Request> brick_requests;
+  std::vector<Request> node_requests;           ///< octree node indices + hits
   std::vector<std::uint32_t> used_cache_slots;  ///< distinct cache slots sampled this frame
   BackendStats stats;
 };

@@ -26,6 +26,9 @@ struct ResolvedRequests {
   std::vector<BrickKey> bricks;
   std::vector<std::uint32_t> hits;  ///< parallel to bricks
   std::uint64_t stale = 0;          ///< requests dropped: remapped or unassigned slot, bad key
+  /// Directory indices of unallocated page-table blocks reported (block-miss keys) for valid
+  /// slots: allocate them (PageTable::allocate_block) after everything is resolved.
+  std::vector<std::uint32_t> block_misses;
 };
 
 /// Slot <-> channel map. Epoch 0 is the initial (all slots unassigned) state; every assign()
@@ -60,7 +63,8 @@ class ChannelMap {
   /// for an epoch from the future (a caller bug, not device data).
   std::optional<BrickKey> resolve(std::uint32_t device_key, std::uint64_t epoch,
                                   const PageTable& table) const;
-  /// resolve() for a frame's drained brick requests, keeping their (priority) order.
+  /// resolve() for a frame's drained brick requests, keeping their (priority) order; block-miss
+  /// keys of valid slots go to `block_misses` instead.
   ResolvedRequests resolve(std::span<const Request> requests, std::uint64_t epoch,
                            const PageTable& table) const;
   /// The page-table address of a global brick, nullopt when its channel is not visible.

@@ -39,6 +39,8 @@ struct FrameStats {
   std::uint64_t page_deltas = 0;      ///< page entries sent (all of them when pages_full)
   std::uint64_t node_deltas = 0;      ///< octree words sent (all of them when nodes_full)
   bool pages_full = false;
+  std::uint64_t block_misses = 0;  ///< unallocated page-table blocks reported (allocated now)
+  std::uint64_t page_blocks = 0;   ///< page-table pool blocks allocated after the frame
   bool nodes_full = false;
 
   // Working set: distinct cache slots the backend sampled.

@@ -53,6 +53,12 @@ struct RendererOptions {
   /// capped at RESOCT_MAX_SLOTS (32).
   std::uint32_t visible_slots = 0;
   std::uint64_t device_cache_bytes = std::uint64_t(512) << 20;
+  /// Blocks of 16^3 page-table entries the sparse page table may allocate (16 KiB of device
+  /// memory each; docs/core-structures.md). 0 = derived: the device cache's slots plus half as
+  /// many again (at least 64) of headroom, clamped to the blocks of all tables. Must exceed the
+  /// cache slots (so that a block without MAPPED entries can always be reclaimed) unless it
+  /// covers every block, and stay below 2^19.
+  std::uint32_t page_pool_blocks = 0;
   std::uint64_t host_cache_bytes = std::uint64_t(1) << 30;
   UploadBudget upload_budget{256, std::numeric_limits<std::uint64_t>::max()};
   std::uint32_t ttl = 2;         ///< frames a fresh upload stays pinned (>= 1)
@@ -170,9 +176,10 @@ class Renderer {
   std::shared_ptr<SharedEye> host_camera_ = std::make_shared<SharedEye>();
   CameraPredictor predictor_;
   std::uint64_t frame_ = 0;
-  bool send_full_ = true;                     // next update carries full arrays
-  std::vector<LoadedBrick> staged_;           // loaded, waiting for budget or a free slot
-  std::vector<std::uint32_t> pending_nodes_;  // node requests to answer next frame
+  bool send_full_ = true;                      // next update carries full arrays
+  std::vector<LoadedBrick> staged_;            // loaded, waiting for budget or a free slot
+  std::vector<std::uint32_t> pending_nodes_;   // node requests to answer next frame
+  std::vector<std::uint32_t> pending_blocks_;  // page-table blocks to allocate next frame
   // Requested bricks -> frame of their first request in an unbroken run of frames (ageing).
   std::unordered_map<BrickKey, std::uint64_t> waiting_since_;
   std::vector<std::byte> scratch_;  // keeps the voxels of this frame's uploads alive

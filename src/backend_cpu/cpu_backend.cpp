@@ -56,6 +56,14 @@ void CpuBackend::configure(const BackendConfig& config) {
   if (config.cache_slots > 0 && slot_voxels * vb > (std::size_t(1) << 62) / config.cache_slots) {
     throw invalid_parameter("config", "cache pool byte size overflows");
   }
+  if (config.page_pool_blocks == 0 ||
+      config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
+    throw invalid_parameter("config", "page_pool_blocks must be 1.." +
+                                          std::to_string(kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS));
+  }
+  if (config.directory_entries >= kernel::RESOCT_REQUEST_MAX_DIRECTORY) {
+    throw invalid_parameter("config", "directory_entries must be below 2^31 - 1");
+  }
   if (config.node_words > (std::uint64_t(1) << 32)) {
     throw invalid_parameter("config", "node_words exceeds 2^32");
   }
@@ -64,8 +72,10 @@ void CpuBackend::configure(const BackendConfig& config) {
   voxel_bytes_ = vb;
   slot_voxels_ = slot_voxels;
   resize_zeroed(cache_, std::size_t(config.cache_slots) * slot_voxels * vb, "brick cache");
-  resize_zeroed(pages_, config.page_entries, "page table");
-  resize_zeroed(page_offsets_, std::size_t(config.page_tables) + 1u, "page table offsets");
+  resize_zeroed(pages_, std::size_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
+                "page pool");
+  resize_zeroed(directory_, config.directory_entries, "page directory");
+  resize_zeroed(directory_offsets_, std::size_t(config.page_tables) + 1u, "page directory offsets");
   resize_zeroed(nodes_, std::size_t(config.node_words), "octree");
   used_words_ = (std::size_t(config.cache_slots) + 63u) / 64u;
   used_bits_ =
@@ -92,24 +102,42 @@ void CpuBackend::update(const FrameUpdate& u) {
     std::memcpy(cache_.data() + std::size_t(b.cache_slot) * brick_bytes, b.voxels.data(),
                 brick_bytes);
   }
+  const std::uint32_t pool_blocks = config_.page_pool_blocks;
   if (u.pages_full) {
-    if (u.all_pages.size() != pages_.size()) {
-      throw invalid_parameter("update", "full page table of " + std::to_string(u.all_pages.size()) +
-                                            " entries, expected " + std::to_string(pages_.size()));
+    if (u.all_pages.size() > pages_.size()) {
+      throw invalid_parameter("update", "full page pool of " + std::to_string(u.all_pages.size()) +
+                                            " words, at most " + std::to_string(pages_.size()));
     }
-    if (u.page_table_offsets.size() != page_offsets_.size()) {
-      throw invalid_parameter("update", "page_table_offsets has the wrong size");
+    if (u.all_directory.size() != directory_.size()) {
+      throw invalid_parameter("update",
+                              "full page directory of " + std::to_string(u.all_directory.size()) +
+                                  " entries, expected " + std::to_string(directory_.size()));
     }
-    for (std::uint32_t o : u.page_table_offsets) {
-      if (o > pages_.size()) throw invalid_parameter("update", "page table offset out of range");
+    if (u.directory_offsets.size() != directory_offsets_.size()) {
+      throw invalid_parameter("update", "directory_offsets has the wrong size");
     }
-    std::copy(u.all_pages.begin(), u.all_pages.end(), pages_.begin());
-    std::copy(u.page_table_offsets.begin(), u.page_table_offsets.end(), page_offsets_.begin());
+    for (std::uint32_t o : u.directory_offsets) {
+      if (o > directory_.size()) throw invalid_parameter("update", "directory offset out of range");
+    }
+    for (std::uint32_t b : u.all_directory) {
+      if (b >= pool_blocks) throw invalid_parameter("update", "directory names no pool block");
+    }
   }
   for (const PageDelta& d : u.page_deltas) {
     if (d.index >= pages_.size()) throw invalid_parameter("update", "page delta out of range");
-    pages_[d.index] = d.value;
   }
+  for (const PageDelta& d : u.directory_deltas) {
+    if (d.index >= directory_.size() || d.value >= pool_blocks)
+      throw invalid_parameter("update", "directory delta out of range");
+  }
+  if (u.pages_full) {
+    std::copy(u.all_pages.begin(), u.all_pages.end(), pages_.begin());
+    std::fill(pages_.begin() + std::ptrdiff_t(u.all_pages.size()), pages_.end(), 0u);
+    std::copy(u.all_directory.begin(), u.all_directory.end(), directory_.begin());
+    std::copy(u.directory_offsets.begin(), u.directory_offsets.end(), directory_offsets_.begin());
+  }
+  for (const PageDelta& d : u.page_deltas) pages_[d.index] = d.value;
+  for (const PageDelta& d : u.directory_deltas) directory_[d.index] = d.value;
   if (u.nodes_full) {
     if (u.all_nodes.size() != nodes_.size()) {
       throw invalid_parameter("update", "full octree of " + std::to_string(u.all_nodes.size()) +
@@ -137,7 +165,8 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   detail::KernelContext& c = detail::g_ctx;
   c.nodes = nodes_.data();
   c.pages = pages_.data();
-  c.page_offsets = page_offsets_.data();
+  c.directory = directory_.data();
+  c.directory_offsets = directory_offsets_.data();
   c.slots = tables.slots.data();
   c.levels = tables.levels.data();
   c.depths = tables.depths.data();
@@ -175,10 +204,8 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   s.distance_skipped = r.skipped;
   s.distance_marched = r.marched;
 
-  const std::uint32_t level_count = frame.level_count;
-  RequestBatch bricks = brick_requests_->drain([level_count](std::uint32_t key) {
-    return kernel::resoct_request_key_table(key) % level_count;
-  });
+  // Brick keys name pool blocks, not levels (FrameResult::brick_requests).
+  RequestBatch bricks = brick_requests_->drain();
   RequestBatch node_batch = node_requests_->drain();
   s.requests_dropped = bricks.dropped + node_batch.dropped;
   result.brick_requests = std::move(bricks.requests);

@@ -24,8 +24,9 @@ namespace resoct::cpu::detail {
 // shared library.
 struct KernelContext {
   const std::uint32_t* nodes = nullptr;
-  const std::uint32_t* pages = nullptr;
-  const std::uint32_t* page_offsets = nullptr;
+  const std::uint32_t* pages = nullptr;  // the page pool
+  const std::uint32_t* directory = nullptr;
+  const std::uint32_t* directory_offsets = nullptr;
   const kernel::ResoctSlotInfo* slots = nullptr;
   const kernel::ResoctLevelInfo* levels = nullptr;
   const kernel::ResoctDepthInfo* depths = nullptr;
@@ -99,8 +100,11 @@ inline uint resoct_read_node(uint index) {
 inline uint resoct_read_page(uint index) {
   return cpu::detail::g_ctx.pages[index];
 }
-inline uint resoct_read_page_table_offset(uint table) {
-  return cpu::detail::g_ctx.page_offsets[table];
+inline uint resoct_read_directory(uint index) {
+  return cpu::detail::g_ctx.directory[index];
+}
+inline uint resoct_read_directory_offset(uint table) {
+  return cpu::detail::g_ctx.directory_offsets[table];
 }
 inline ResoctSlotInfo resoct_read_slot(uint i) {
   return cpu::detail::g_ctx.slots[i];

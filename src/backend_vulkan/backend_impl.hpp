@@ -38,8 +38,8 @@ enum Binding : std::uint32_t {
   b_levels,
   b_depths,
   b_nodes,
-  b_pages,
-  b_page_offsets,
+  b_pages,  // the page pool
+  b_directory_offsets,
   b_tf,
   b_cache,
   b_brick_requests,
@@ -49,6 +49,7 @@ enum Binding : std::uint32_t {
   b_stats,
   b_cache1,  // cache chunks 1..7 (chunk 0 is b_cache)
   b_cache7 = b_cache1 + 6,
+  b_directory,  // the page directory
   binding_count
 };
 

@@ -45,7 +45,9 @@ void VulkanBackend::update(const FrameUpdate& u) {
   Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("update", "backend is not configured");
   const std::size_t brick_bytes = m.slot_voxels * m.voxel_bytes;
-  const std::size_t page_count = m.config.page_entries;
+  const std::size_t page_count =
+      std::size_t(m.config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES;
+  const std::size_t dir_count = m.config.directory_entries;
   const std::size_t node_count = std::size_t(m.config.node_words);
   // Validate everything before recording anything, so that a rejected update changes nothing.
   for (const BrickUpload& b : u.bricks) {
@@ -60,19 +62,32 @@ void VulkanBackend::update(const FrameUpdate& u) {
     }
   }
   if (u.pages_full) {
-    if (u.all_pages.size() != page_count) {
-      throw invalid_parameter("update", "full page table of " + std::to_string(u.all_pages.size()) +
-                                            " entries, expected " + std::to_string(page_count));
+    if (u.all_pages.size() > page_count) {
+      throw invalid_parameter("update", "full page pool of " + std::to_string(u.all_pages.size()) +
+                                            " words, at most " + std::to_string(page_count));
     }
-    if (u.page_table_offsets.size() != std::size_t(m.config.page_tables) + 1u) {
-      throw invalid_parameter("update", "page_table_offsets has the wrong size");
+    if (u.all_directory.size() != dir_count) {
+      throw invalid_parameter("update", "full page directory of " +
+                                            std::to_string(u.all_directory.size()) +
+                                            " entries, expected " + std::to_string(dir_count));
     }
-    for (std::uint32_t o : u.page_table_offsets) {
-      if (o > page_count) throw invalid_parameter("update", "page table offset out of range");
+    if (u.directory_offsets.size() != std::size_t(m.config.page_tables) + 1u) {
+      throw invalid_parameter("update", "directory_offsets has the wrong size");
+    }
+    for (std::uint32_t o : u.directory_offsets) {
+      if (o > dir_count) throw invalid_parameter("update", "directory offset out of range");
+    }
+    for (std::uint32_t b : u.all_directory) {
+      if (b >= m.config.page_pool_blocks)
+        throw invalid_parameter("update", "directory names no pool block");
     }
   }
   for (const PageDelta& d : u.page_deltas) {
     if (d.index >= page_count) throw invalid_parameter("update", "page delta out of range");
+  }
+  for (const PageDelta& d : u.directory_deltas) {
+    if (d.index >= dir_count || d.value >= m.config.page_pool_blocks)
+      throw invalid_parameter("update", "directory delta out of range");
   }
   if (u.nodes_full && u.all_nodes.size() != node_count) {
     throw invalid_parameter("update", "full octree of " + std::to_string(u.all_nodes.size()) +
@@ -100,8 +115,10 @@ void VulkanBackend::update(const FrameUpdate& u) {
     }
   }
   const auto page_pairs = unique_pairs(u.page_deltas);
+  const auto dir_pairs = unique_pairs(u.directory_deltas);
   const auto node_pairs = unique_pairs(u.node_deltas);
-  if (last.empty() && !u.pages_full && page_pairs.empty() && !u.nodes_full && node_pairs.empty()) {
+  if (last.empty() && !u.pages_full && page_pairs.empty() && dir_pairs.empty() && !u.nodes_full &&
+      node_pairs.empty()) {
     return;
   }
   m.begin_batch();
@@ -113,14 +130,22 @@ void VulkanBackend::update(const FrameUpdate& u) {
   }
   // The CPU backend applies a full array before the deltas of the same update; so does this.
   if (u.pages_full) {
+    // The pool beyond the host's prefix reads UNMAPPED (disjoint from the copy: no barrier).
+    const VkDeviceSize prefix = VkDeviceSize(u.all_pages.size()) * 4;
+    if (prefix < VkDeviceSize(page_count) * 4) {
+      vkCmdFillBuffer(m.cmd, m.buf[b_pages].buffer, prefix, VkDeviceSize(page_count) * 4 - prefix,
+                      0);
+    }
     m.stage_copy(m.buf[b_pages].buffer, 0, bytes_of(u.all_pages));
-    m.stage_copy(m.buf[b_page_offsets].buffer, 0, bytes_of(u.page_table_offsets));
+    m.stage_copy(m.buf[b_directory].buffer, 0, bytes_of(u.all_directory));
+    m.stage_copy(m.buf[b_directory_offsets].buffer, 0, bytes_of(u.directory_offsets));
   }
   if (u.nodes_full) m.stage_copy(m.buf[b_nodes].buffer, 0, bytes_of(u.all_nodes));
-  if (!page_pairs.empty() || !node_pairs.empty()) {
+  if (!page_pairs.empty() || !dir_pairs.empty() || !node_pairs.empty()) {
     m.begin_batch();
     if (u.pages_full || u.nodes_full) m.barrier();
     m.stage_scatter(ScatterTarget::pages, page_pairs, std::uint32_t(page_count));
+    m.stage_scatter(ScatterTarget::directory, dir_pairs, std::uint32_t(dir_count));
     m.stage_scatter(ScatterTarget::nodes, node_pairs, std::uint32_t(node_count));
   }
 }

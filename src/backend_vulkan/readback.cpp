@@ -16,14 +16,12 @@ namespace {
 
 // Compacts the occupied entries of a device request set (keys in [0, cap), hits in
 // [cap, 2 cap)), ordered like RequestSet::drain.
-void drain(const std::uint32_t* set, std::uint32_t cap, std::uint32_t level_count,
-           std::vector<Request>& out) {
+// Brick keys name pool blocks, not levels, so every request has level 0 (as on the CPU).
+void drain(const std::uint32_t* set, std::uint32_t cap, std::vector<Request>& out) {
   out.clear();
   for (std::uint32_t i = 0; i < cap; ++i) {
     if (set[i] == kernel::RESOCT_REQUEST_KEY_NONE) continue;
-    const std::uint32_t level =
-        level_count ? kernel::resoct_request_key_table(set[i]) % level_count : 0u;
-    out.push_back(Request{set[i], set[cap + i], level});
+    out.push_back(Request{set[i], set[cap + i], 0u});
   }
   std::sort(out.begin(), out.end(), [](const Request& a, const Request& b) {
     if (a.level != b.level) return a.level > b.level;
@@ -101,8 +99,8 @@ void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
   s.ms_device = timer->ms();
 
   drain(reinterpret_cast<const std::uint32_t*>(base + l.brick_requests), brick_capacity,
-        frame.level_count, result.brick_requests);
-  drain(reinterpret_cast<const std::uint32_t*>(base + l.node_requests), node_capacity, 0,
+        result.brick_requests);
+  drain(reinterpret_cast<const std::uint32_t*>(base + l.node_requests), node_capacity,
         result.node_requests);
 
   result.used_cache_slots.clear();
@@ -129,12 +127,16 @@ std::vector<std::byte> VulkanBackend::debug_read(DeviceArray array) const {
       bytes = std::size_t(m.config.cache_slots) * m.slot_voxels * m.voxel_bytes;
       break;
     case DeviceArray::pages:
-      bytes = std::size_t(m.config.page_entries) * 4;
+      bytes = std::size_t(m.config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES * 4;
       b = b_pages;
       break;
-    case DeviceArray::page_offsets:
+    case DeviceArray::directory:
+      bytes = std::size_t(m.config.directory_entries) * 4;
+      b = b_directory;
+      break;
+    case DeviceArray::directory_offsets:
       bytes = (std::size_t(m.config.page_tables) + 1) * 4;
-      b = b_page_offsets;
+      b = b_directory_offsets;
       break;
     case DeviceArray::nodes:
       bytes = std::size_t(m.config.node_words) * 4;

@@ -12,7 +12,7 @@
 namespace resoct::vk::detail {
 
 /// Arrays the scatter pass writes; one descriptor set each.
-enum class ScatterTarget : std::uint32_t { pages, nodes, count };
+enum class ScatterTarget : std::uint32_t { pages, directory, nodes, count };
 
 class ScatterPass {
  public:

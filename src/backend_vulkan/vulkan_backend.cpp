@@ -102,13 +102,23 @@ void VulkanBackend::configure(const BackendConfig& config) {
   }
   const std::uint64_t cache_bytes =
       (std::uint64_t(config.cache_slots) * slot_voxels * vb + 3) & ~3ull;
-  const std::array<std::pair<std::uint64_t, const char*>, 6> sizes = {{
-      {std::uint64_t(config.page_entries) * 4, "page table"},
-      {(std::uint64_t(config.page_tables) + 1) * 4, "page table offsets"},
+  if (config.page_pool_blocks == 0 ||
+      config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
+    throw invalid_parameter("config", "page_pool_blocks must be 1.." +
+                                          std::to_string(kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS));
+  }
+  if (config.directory_entries >= kernel::RESOCT_REQUEST_MAX_DIRECTORY) {
+    throw invalid_parameter("config", "directory_entries must be below 2^31 - 1");
+  }
+  const std::array<std::pair<std::uint64_t, const char*>, 7> sizes = {{
+      {std::uint64_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES * 4,
+       "page pool (RendererOptions::page_pool_blocks)"},
+      {(std::uint64_t(config.page_tables) + 1) * 4, "page directory offsets"},
       {config.node_words * 4, "octree"},
       {std::uint64_t(brick_cap) * 8, "brick request set"},
       {std::uint64_t(node_cap) * 8, "node request set"},
       {(std::uint64_t(config.cache_slots) + 31) / 32 * 4, "used-slot bitmap"},
+      {std::max<std::uint64_t>(config.directory_entries, 1) * 4, "page directory"},
   }};
   std::uint64_t total = cache_bytes;
   for (const auto& [bytes, what] : sizes) {
@@ -151,8 +161,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
     const std::uint32_t n = std::min(config.cache_slots - first, slots_per_chunk);
     m.ensure(cache_binding(c), (std::uint64_t(n) * brick_bytes + 3) & ~3ull, "brick cache");
   }
-  const Binding order[] = {b_pages,          b_page_offsets,  b_nodes,
-                           b_brick_requests, b_node_requests, b_used};
+  const Binding order[] = {b_pages, b_directory_offsets, b_nodes, b_brick_requests, b_node_requests,
+                           b_used,  b_directory};
   for (std::size_t i = 0; i < sizes.size(); ++i)
     m.ensure(order[i], sizes[i].first, sizes[i].second);
   m.ensure(b_stats, kStatWords * 4, "statistics");
@@ -162,6 +172,8 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.ensure_readback(readback_bytes);
   m.scatter->bind(ScatterTarget::pages, m.ring.buffer(), m.ring.capacity(), m.buf[b_pages].buffer,
                   m.buf[b_pages].size);
+  m.scatter->bind(ScatterTarget::directory, m.ring.buffer(), m.ring.capacity(),
+                  m.buf[b_directory].buffer, m.buf[b_directory].size);
   m.scatter->bind(ScatterTarget::nodes, m.ring.buffer(), m.ring.capacity(), m.buf[b_nodes].buffer,
                   m.buf[b_nodes].size);
   // All state reads as zero after configure().

@@ -93,6 +93,15 @@ ResolvedRequests ChannelMap::resolve(std::span<const Request> requests, std::uin
   out.bricks.reserve(requests.size());
   out.hits.reserve(requests.size());
   for (const Request& r : requests) {
+    if (const std::optional<BlockMiss> miss = table.decode_block_miss(r.key)) {
+      if (miss->slot < slot_count() && assigned_at_[miss->slot] <= epoch &&
+          slot_channel_[miss->slot] >= 0) {
+        out.block_misses.push_back(miss->directory_index);
+      } else {
+        ++out.stale;
+      }
+      continue;
+    }
     if (const std::optional<BrickKey> key = resolve(r.key, epoch, table)) {
       out.bricks.push_back(*key);
       out.hits.push_back(r.hits);

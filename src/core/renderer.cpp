@@ -9,6 +9,7 @@
 #include "resoct/error.hpp"
 #include "resoct/frame_tables.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct {
 
@@ -28,6 +29,33 @@ const BrickSource& checked_source(const std::shared_ptr<const BrickSource>& s) {
 std::uint32_t slot_count_for(const RendererOptions& o, const BrickSource& s) {
   if (o.visible_slots != 0) return o.visible_slots;
   return std::min(s.volume().channels, kernel::RESOCT_MAX_SLOTS);
+}
+
+// The sparse page table's pool capacity (RendererOptions::page_pool_blocks).
+std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
+                              std::uint32_t slots) {
+  const std::uint64_t total = PageTable::block_count(h, slots);
+  const std::uint64_t slot_bytes = h.layout().padded_voxels() * voxel_size(h.volume().type);
+  const std::uint64_t cache_slots = o.device_cache_bytes / slot_bytes;
+  constexpr std::uint64_t kMax = kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS - 1u;
+  std::uint64_t blocks = o.page_pool_blocks;
+  if (blocks == 0) {
+    blocks = std::min(total, cache_slots + std::max<std::uint64_t>(cache_slots / 2u, 64u));
+    blocks = std::min(blocks, kMax);
+  }
+  if (blocks > kMax) {
+    throw invalid_parameter("page_pool_blocks", std::to_string(blocks) + " exceeds the " +
+                                                    std::to_string(kMax) +
+                                                    " blocks 32-bit request keys address");
+  }
+  if (blocks < total && blocks <= cache_slots) {
+    throw invalid_parameter("page_pool_blocks",
+                            std::to_string(blocks) + " blocks must exceed the device cache's " +
+                                std::to_string(cache_slots) + " slots (or cover all " +
+                                std::to_string(total) +
+                                " blocks); raise it or lower device_cache_bytes");
+  }
+  return std::uint32_t(blocks);
 }
 
 std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, const BrickHierarchy& h,
@@ -104,7 +132,8 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
       options_((options.validate(), std::move(options))),
       hierarchy_(checked_source(source_).hierarchy()),
       layout_(hierarchy_.volume().extent, options_.leaf_size),
-      pages_(hierarchy_, slot_count_for(options_, *source_)),
+      pages_(hierarchy_, slot_count_for(options_, *source_),
+             pool_blocks_for(options_, hierarchy_, slot_count_for(options_, *source_))),
       channels_(pages_.slot_count(), hierarchy_.volume().channels) {
   cache_ = std::make_unique<BrickCache>(hierarchy_.layout(), hierarchy_.volume().type,
                                         options_.device_cache_bytes, options_.ttl,
@@ -123,7 +152,8 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
   config_.voxel_type = hierarchy_.volume().type;
   config_.padded_brick = hierarchy_.layout().padded_size();
   config_.cache_slots = cache_->slot_count();
-  config_.page_entries = std::uint32_t(pages_.entries().size());
+  config_.page_pool_blocks = pages_.pool_block_count();
+  config_.directory_entries = std::uint32_t(pages_.directory().size());
   config_.page_tables = pages_.table_count();
   config_.node_words = octree_->words().size();
   config_.brick_request_capacity = options_.brick_request_capacity;
@@ -289,16 +319,19 @@ void Renderer::answer_nodes(FrameStats& stats) {
 void Renderer::send_update(FrameStats& stats) {
   FrameUpdate u;
   u.bricks = uploads_;
-  const std::vector<PageDelta> page_deltas = pages_.take_deltas();
-  // Past a quarter of the table a full upload is cheaper than scattering deltas.
-  if (send_full_ || page_deltas.size() > pages_.entries().size() / 4) {
+  const PageTableDeltas page_deltas = pages_.take_deltas();
+  // Past a quarter of the words a full upload is cheaper than scattering deltas.
+  const std::size_t words = pages_.pool().size() + pages_.directory().size();
+  if (send_full_ || page_deltas.pool.size() + page_deltas.directory.size() > words / 4) {
     u.pages_full = true;
-    u.all_pages = pages_.entries();
-    u.page_table_offsets = pages_.table_offsets();
-    stats.page_deltas = pages_.entries().size();
+    u.all_pages = pages_.pool();
+    u.all_directory = pages_.directory();
+    u.directory_offsets = pages_.directory_offsets();
+    stats.page_deltas = words;
   } else {
-    u.page_deltas = page_deltas;
-    stats.page_deltas = page_deltas.size();
+    u.page_deltas = page_deltas.pool;
+    u.directory_deltas = page_deltas.directory;
+    stats.page_deltas = page_deltas.pool.size() + page_deltas.directory.size();
   }
   const OctreeDeltas node_deltas = octree_->take_deltas();
   if (send_full_ || node_deltas.full) {
@@ -349,6 +382,11 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
       if (j > 0) ++stats.ancestor_requests;
     }
   }
+  // Allocated at the start of the next frame, with the other page-table changes, so that the
+  // device mirrors the host between frames (allocation may reclaim blocks).
+  pending_blocks_ = resolved.block_misses;
+  stats.block_misses = resolved.block_misses.size();
+  if (!resolved.block_misses.empty()) outstanding = true;
   waiting_since_ = std::move(still_waiting);
   loader_->request(wanted);
   if (loader_->thread_count() == 0) {
@@ -444,7 +482,10 @@ FrameReport Renderer::render_frame(const Scene& scene) {
 
   auto t = Clock::now();
   assign_channels(scene);
+  for (std::uint32_t d : pending_blocks_) pages_.allocate_block(d);
+  pending_blocks_.clear();
   apply_loaded(stats);
+  stats.page_blocks = pages_.allocated_blocks();
   answer_nodes(stats);
   stats.ms_upload = ms_since(t);
 

@@ -21,7 +21,7 @@ BrickHierarchy hierarchy(std::uint32_t channels) {
 
 TEST(ChannelMap, KeysFromBeforeARemapOfTheirSlotAreDropped) {
   const BrickHierarchy h = hierarchy(6);
-  PageTable pt(h, 2);
+  PageTable pt(h, 2, 64);
   ChannelMap cm(2, 6);
   EXPECT_EQ(cm.epoch(), 0u);
   EXPECT_FALSE(cm.channel(0).has_value());
@@ -30,6 +30,9 @@ TEST(ChannelMap, KeysFromBeforeARemapOfTheirSlotAreDropped) {
   const std::uint64_t e1 = cm.epoch();
   EXPECT_EQ(e1, 2u);
   const PageAddress a0{0, 1, {2, 1, 0}}, a1{1, 0, {4, 4, 2}};
+  // Brick keys exist once the bricks' blocks are allocated.
+  pt.allocate_block(pt.directory_index(a0));
+  pt.allocate_block(pt.directory_index(a1));
   const std::uint32_t k0 = pt.device_key(a0), k1 = pt.device_key(a1);
   EXPECT_EQ(cm.resolve(k0, e1, pt), BrickKey(1, 4, {2, 1, 0}));
   EXPECT_EQ(cm.resolve(k1, e1, pt), BrickKey(0, 2, {4, 4, 2}));
@@ -39,7 +42,10 @@ TEST(ChannelMap, KeysFromBeforeARemapOfTheirSlotAreDropped) {
   EXPECT_EQ(cm.epoch(), e1 + 1);
   EXPECT_FALSE(cm.resolve(k0, e1, pt).has_value());
   EXPECT_EQ(cm.resolve(k1, e1, pt), BrickKey(0, 2, {4, 4, 2}));
-  EXPECT_EQ(cm.resolve(k0, cm.epoch(), pt), BrickKey(1, 5, {2, 1, 0}));
+  // The remap freed slot 0's blocks; a key recorded under the new mapping resolves to it.
+  EXPECT_FALSE(cm.resolve(k0, cm.epoch(), pt).has_value());
+  pt.allocate_block(pt.directory_index(a0));
+  EXPECT_EQ(cm.resolve(pt.device_key(a0), cm.epoch(), pt), BrickKey(1, 5, {2, 1, 0}));
   // Keys recorded before the slot was ever assigned are stale as well.
   EXPECT_FALSE(cm.resolve(k1, 1, pt).has_value());
   // Unassigned slot: nothing resolves.
@@ -51,7 +57,7 @@ TEST(ChannelMap, KeysFromBeforeARemapOfTheirSlotAreDropped) {
 
 TEST(ChannelMap, RemapClearsTheSlotsTablesAndReportsCacheSlots) {
   const BrickHierarchy h = hierarchy(3);
-  PageTable pt(h, 2);
+  PageTable pt(h, 2, 64);
   ChannelMap cm(2, 3);
   cm.assign(0, 0, pt);
   cm.assign(1, 1, pt);
@@ -66,7 +72,10 @@ TEST(ChannelMap, RemapClearsTheSlotsTablesAndReportsCacheSlots) {
   EXPECT_EQ(pt.entry({0, 0, {1, 1, 1}}), k::RESOCT_PAGE_UNMAPPED_WORD);
   EXPECT_EQ(pt.entry({0, 1, {0, 0, 0}}), k::RESOCT_PAGE_UNMAPPED_WORD);
   EXPECT_EQ(pt.entry({1, 0, {1, 1, 1}}), k::resoct_page_encode_mapped(12));
-  EXPECT_EQ(pt.take_deltas().size(), 3u);
+  const PageTableDeltas d = pt.take_deltas();
+  EXPECT_EQ(d.pool.size(), 3u);       // the three entries of slot 0
+  EXPECT_EQ(d.directory.size(), 3u);  // and their blocks (one per level) freed
+  for (const PageDelta& x : d.directory) EXPECT_EQ(x.value, 0u);
   // Re-assigning the same channel changes nothing.
   const std::uint64_t e = cm.epoch();
   pt.set_mapped({0, 0, {0, 0, 0}}, 13);
@@ -78,7 +87,7 @@ TEST(ChannelMap, RemapClearsTheSlotsTablesAndReportsCacheSlots) {
 
 TEST(ChannelMap, LookupsBothWaysAndErrors) {
   const BrickHierarchy h = hierarchy(4);
-  PageTable pt(h, 2);
+  PageTable pt(h, 2, 64);
   ChannelMap cm(2, 4);
   cm.assign(1, 3, pt);
   EXPECT_EQ(cm.slot_of(3), 1u);
@@ -89,7 +98,7 @@ TEST(ChannelMap, LookupsBothWaysAndErrors) {
   EXPECT_RESOCT_ERROR(cm.assign(0, 3, pt), ErrorCode::invalid_argument, "already shown in slot 1");
   EXPECT_RESOCT_ERROR(cm.assign(0, 4, pt), ErrorCode::invalid_argument, "channel");
   EXPECT_RESOCT_ERROR(cm.assign(2, 0, pt), ErrorCode::out_of_range, "slot");
-  PageTable other(h, 3);
+  PageTable other(h, 3, 64);
   EXPECT_RESOCT_ERROR(cm.assign(0, 0, other), ErrorCode::invalid_argument, "table");
   EXPECT_RESOCT_ERROR(ChannelMap(0, 4), ErrorCode::invalid_argument, "slots");
   EXPECT_RESOCT_ERROR(ChannelMap(2, 0), ErrorCode::invalid_argument, "channels");
@@ -103,18 +112,23 @@ TEST(ChannelMap, LookupsBothWaysAndErrors) {
 
 TEST(ChannelMap, ResolvesADrainedBatchAndCountsStaleRequests) {
   const BrickHierarchy h = hierarchy(4);
-  PageTable pt(h, 2);
+  PageTable pt(h, 2, 64);
   ChannelMap cm(2, 4);
   cm.assign(0, 1, pt);
   cm.assign(1, 3, pt);
   const std::uint64_t recorded = cm.epoch();
   RequestSet rs(64);
   const PageAddress a{0, 0, {1, 2, 0}}, b{1, 2, {0, 1, 0}}, c{0, 1, {2, 0, 1}};
+  const PageAddress miss0{0, 3, {0, 0, 0}}, miss1{1, 3, {0, 0, 0}};
+  for (const PageAddress& x : {a, b, c}) pt.allocate_block(pt.directory_index(x));
   rs.insert(pt.device_key(a), 5);
   rs.insert(pt.device_key(b), 9);
   rs.insert(pt.device_key(c), 2);
-  rs.insert(k::resoct_request_key_encode(pt.table_count(), 0));  // garbage from the device
-  cm.assign(1, 2, pt);                                           // slot 1 remapped after recording
+  rs.insert(pt.device_key(miss0), 1);  // block misses: slot 0 valid, slot 1 remapped below
+  rs.insert(pt.device_key(miss1), 1);
+  rs.insert(k::resoct_request_key_brick(pt.pool_block_count(), 0));  // garbage from the device
+  rs.insert(k::resoct_request_key_block_miss(0x7FFFFFF0u));          // garbage as well
+  cm.assign(1, 2, pt);  // slot 1 remapped after recording
   const RequestBatch batch = rs.drain([&](std::uint32_t key) {
     const auto d = pt.decode_device_key(key);
     return d ? d->level : 0u;
@@ -124,5 +138,6 @@ TEST(ChannelMap, ResolvesADrainedBatchAndCountsStaleRequests) {
   EXPECT_EQ(r.bricks,
             (std::vector<BrickKey>{BrickKey(1, 1, {2, 0, 1}), BrickKey(0, 1, {1, 2, 0})}));
   EXPECT_EQ(r.hits, (std::vector<std::uint32_t>{2, 5}));
-  EXPECT_EQ(r.stale, 2u);
+  EXPECT_EQ(r.block_misses, (std::vector<std::uint32_t>{pt.directory_index(miss0)}));
+  EXPECT_EQ(r.stale, 4u);
 }

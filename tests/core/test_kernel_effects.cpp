@@ -36,7 +36,10 @@ inline uint resoct_read_node(uint i) {
 inline uint resoct_read_page(uint i) {
   return test::g.backend->pages()[i];
 }
-inline uint resoct_read_page_table_offset(uint t) {
+inline uint resoct_read_directory(uint i) {
+  return test::g.backend->directory()[i];
+}
+inline uint resoct_read_directory_offset(uint t) {
   return (*test::g.offsets)[t];
 }
 inline ResoctSlotInfo resoct_read_slot(uint i) {
@@ -110,7 +113,7 @@ struct KernelRig {
     rs.upload(backend);
     tables = rs.tables(scene);
     g.backend = &backend;
-    g.offsets = &rs.pages().table_offsets();
+    g.offsets = &rs.pages().directory_offsets();
     g.tables = &tables;
     g.padded = glm::ivec3(layout.padded_size());
   }

@@ -20,10 +20,14 @@ static_assert(k::RESOCT_PAGE_EMPTY_WORD == k::RESOCT_PAGE_STATE_EMPTY
                                                << k::RESOCT_PAGE_STATE_SHIFT);
 static_assert(k::RESOCT_PAGE_STATE_HOMOGENEOUS == 3u &&
               (3u << k::RESOCT_PAGE_STATE_SHIFT) >> k::RESOCT_PAGE_STATE_SHIFT == 3u);
-static_assert(k::RESOCT_REQUEST_BRICK_BITS + k::RESOCT_REQUEST_TABLE_BITS == 32u);
-static_assert(k::RESOCT_REQUEST_MAX_TABLES == 1u << k::RESOCT_REQUEST_TABLE_BITS);
-static_assert(k::RESOCT_REQUEST_BRICK_MASK == (1u << k::RESOCT_REQUEST_BRICK_BITS) - 1u);
-static_assert(k::RESOCT_REQUEST_MAX_BRICKS_PER_TABLE == k::RESOCT_REQUEST_BRICK_MASK);
+// Brick keys: 19 bits of pool block above 12 bits of in-block index, bit 31 clear.
+static_assert(k::RESOCT_REQUEST_IN_BLOCK_MASK + 1u == k::RESOCT_PAGE_BLOCK_ENTRIES);
+static_assert(k::RESOCT_PAGE_BLOCK_ENTRIES == 1u << (3u * k::RESOCT_PAGE_BLOCK_LOG2));
+static_assert(k::RESOCT_PAGE_BLOCK_ENTRIES == 1u << k::RESOCT_PAGE_BLOCK_ENTRIES_LOG2);
+static_assert(k::RESOCT_REQUEST_MAX_POOL_BLOCKS == k::RESOCT_REQUEST_POOL_BLOCK_MASK + 1u);
+static_assert((k::RESOCT_REQUEST_POOL_BLOCK_MASK << k::RESOCT_REQUEST_IN_BLOCK_BITS |
+               k::RESOCT_REQUEST_IN_BLOCK_MASK) == 0x7FFFFFFFu);
+static_assert(k::RESOCT_REQUEST_MAX_DIRECTORY == ~k::RESOCT_REQUEST_BLOCK_MISS_BIT);
 static_assert(sizeof(k::uint) == 4u);
 // Deltas go to device buffers as (index, value) word pairs.
 static_assert(sizeof(PageDelta) == 8u && offsetof(PageDelta, value) == 4u);
@@ -57,13 +61,20 @@ TEST(KernelLayout, PageEntryRoundTripsAtLimits) {
 }
 
 TEST(KernelLayout, RequestKeyRoundTripsAtLimits) {
-  for (std::uint32_t t : {0u, 1u, 63u, k::RESOCT_REQUEST_MAX_TABLES - 1u}) {
-    for (std::uint32_t local : {0u, 1u, 0x00ABCDEFu, k::RESOCT_REQUEST_MAX_BRICKS_PER_TABLE - 1u}) {
-      const std::uint32_t key = k::resoct_request_key_encode(t, local);
-      EXPECT_EQ(k::resoct_request_key_table(key), t);
-      EXPECT_EQ(k::resoct_request_key_local(key), local);
+  for (std::uint32_t b : {1u, 2u, 0x1234u, k::RESOCT_REQUEST_MAX_POOL_BLOCKS - 1u}) {
+    for (std::uint32_t in : {0u, 1u, 0xABCu, k::RESOCT_PAGE_BLOCK_ENTRIES - 1u}) {
+      const std::uint32_t key = k::resoct_request_key_brick(b, in);
+      EXPECT_FALSE(k::resoct_request_key_is_block_miss(key));
+      EXPECT_EQ(k::resoct_request_key_pool_block(key), b);
+      EXPECT_EQ(k::resoct_request_key_in_block(key), in);
       EXPECT_NE(key, k::RESOCT_REQUEST_KEY_NONE);
     }
+  }
+  for (std::uint32_t d : {0u, 1u, 0x00ABCDEFu, k::RESOCT_REQUEST_MAX_DIRECTORY - 1u}) {
+    const std::uint32_t key = k::resoct_request_key_block_miss(d);
+    EXPECT_TRUE(k::resoct_request_key_is_block_miss(key));
+    EXPECT_EQ(k::resoct_request_key_directory(key), d);
+    EXPECT_NE(key, k::RESOCT_REQUEST_KEY_NONE);
   }
   EXPECT_EQ(k::resoct_request_table_id(3u, 5u, 9u), 3u * 9u + 5u);
   std::mt19937 rng(7);
@@ -95,14 +106,20 @@ TEST(KernelLayout, HostKeysAndEntriesUseTheKernelEncoding) {
   v.extent = {795, 3, 1};
   v.channels = 3;
   const BrickHierarchy h(v, BrickLayout{glm::uvec3(8), 1});
-  PageTable pt(h, 3);
+  PageTable pt(h, 3, 16);
   const PageAddress a{2, 1, glm::uvec3(17, 0, 0)};
-  const std::uint32_t key = pt.device_key(a);
-  EXPECT_EQ(k::resoct_request_key_table(key), 2u * h.level_count() + 1u);
-  EXPECT_EQ(k::resoct_request_key_local(key), 17u);
+  // Level 1 is 50 bricks wide: 4 blocks; brick 17 lies in block 1 at x = 1.
+  const std::uint32_t d = pt.directory_offsets()[2u * h.level_count() + 1u] + 1u;
+  EXPECT_EQ(pt.directory_index(a), d);
+  EXPECT_EQ(pt.device_key(a), k::resoct_request_key_block_miss(d));
   pt.set_mapped(a, k::RESOCT_PAGE_MAX_CACHE_SLOT);
   EXPECT_EQ(pt.entry(a), k::resoct_page_encode_mapped(k::RESOCT_PAGE_MAX_CACHE_SLOT));
-  EXPECT_EQ(pt.entries()[pt.table_offsets()[k::resoct_request_key_table(key)] + 17u], pt.entry(a));
+  const std::uint32_t block = pt.directory()[d];
+  EXPECT_NE(block, 0u);
+  const std::uint32_t key = pt.device_key(a);
+  EXPECT_EQ(k::resoct_request_key_pool_block(key), block);
+  EXPECT_EQ(k::resoct_request_key_in_block(key), 1u);
+  EXPECT_EQ(pt.pool()[block * k::RESOCT_PAGE_BLOCK_ENTRIES + 1u], pt.entry(a));
   // A cache cannot hand out a slot the entry cannot hold: 2^30 slots is its limit (checked before
   // anything is allocated).
   const BrickLayout small{glm::uvec3(4), 0};

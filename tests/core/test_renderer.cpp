@@ -176,6 +176,7 @@ TEST(Renderer, MoreImportantChannelsLoadFirstWithinALevel) {
   Scene scene = test_scene(0);
   scene.channels.push_back(test_scene(2).channels[0]);
   scene.channels[1].importance = -1;  // channel 2 before channel 0
+  r.render_frame(scene);              // block misses: the page-table blocks are allocated
   r.render_frame(scene);  // requests; loads 3 bricks: level 2 of both channels, then level 1
   r.render_frame(scene);  // applies them
   auto level1_set = [&](std::uint32_t channel) {

@@ -124,7 +124,13 @@ struct Rig {
 inline std::string check_state(const Renderer& r, const RecordingBackend& b,
                                const BrickSource& src) {
   if (auto e = r.octree().check_invariants()) return "octree: " + *e;
-  if (b.pages() != r.page_table().entries()) return "page mirror differs from host";
+  const auto& pool = r.page_table().pool();
+  if (b.pages().size() < pool.size() || !std::equal(pool.begin(), pool.end(), b.pages().begin()) ||
+      !std::all_of(b.pages().begin() + std::ptrdiff_t(pool.size()), b.pages().end(),
+                   [](std::uint32_t w) { return w == 0u; })) {
+    return "page pool mirror differs from host";
+  }
+  if (b.directory() != r.page_table().directory()) return "directory mirror differs from host";
   const auto words = r.octree().words();
   if (!std::equal(words.begin(), words.end(), b.nodes().begin(), b.nodes().end())) {
     return "node mirror differs from host";

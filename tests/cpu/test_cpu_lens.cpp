@@ -294,14 +294,12 @@ TEST(CpuLens, HugeVolumePagesOnlyTheNeighbourhood) {
   std::uint32_t resident = 0;
   for (std::uint32_t l = 0; l < h.level_count(); ++l) {
     const glm::uvec3 nb = h.level(l).bricks;
-    const std::uint32_t begin = pages.table_offsets()[l], end = pages.table_offsets()[l + 1];
-    for (std::uint32_t i = begin; i < end; ++i) {
-      if (kernel::resoct_page_state(pages.entries()[i]) == kernel::RESOCT_PAGE_STATE_UNMAPPED) {
+    for (std::uint32_t local = 0; local < nb.x * nb.y * nb.z; ++local) {
+      const glm::uvec3 b(local % nb.x, (local / nb.x) % nb.y, local / (nb.x * nb.y));
+      if (kernel::resoct_page_state(pages.entry({0, l, b})) == kernel::RESOCT_PAGE_STATE_UNMAPPED) {
         continue;
       }
       ++resident;
-      const std::uint32_t local = i - begin;
-      const glm::uvec3 b(local % nb.x, (local / nb.x) % nb.y, local / (nb.x * nb.y));
       const auto [lo, hi] = brick_box(h, l, b, 65536.0);
       EXPECT_TRUE(box_meets_lens(lo, hi, lens)) << "level " << l;
     }

@@ -365,10 +365,17 @@ TEST(CpuTraverse, BackendRejectsBadUpdatesAndTables) {
   FrameUpdate u;
   u.bricks = std::span<const BrickUpload>(&up, 1);
   EXPECT_RESOCT_ERROR(b.update(u), ErrorCode::invalid_argument, "update");
-  PageDelta d{std::uint32_t(rs.pages().entries().size()), 0};
+  PageDelta d{rs.pages().pool_block_count() * kernel::RESOCT_PAGE_BLOCK_ENTRIES, 0};
   FrameUpdate u2;
   u2.page_deltas = std::span<const PageDelta>(&d, 1);
   EXPECT_RESOCT_ERROR(b.update(u2), ErrorCode::invalid_argument, "update");
+  // A directory word naming no pool block, and one outside the directory.
+  for (const PageDelta bad : {PageDelta{0, rs.pages().pool_block_count()},
+                              PageDelta{std::uint32_t(rs.pages().directory().size()), 0}}) {
+    FrameUpdate u3;
+    u3.directory_deltas = std::span<const PageDelta>(&bad, 1);
+    EXPECT_RESOCT_ERROR(b.update(u3), ErrorCode::invalid_argument, "directory delta");
+  }
   Scene s = make_scene(8, oblique());
   s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0.5}}})};
   FrameTables t = rs.tables(s);

@@ -22,7 +22,7 @@ struct Fixture {
   explicit Fixture(VolumeDesc v)
       : hierarchy(v, BrickLayout{}),
         layout(v.extent, glm::uvec3(16)),
-        pages(hierarchy, 1),
+        pages(hierarchy, 1, 16),
         channels(1, v.channels) {
     channels.assign(0, 0, pages);
   }

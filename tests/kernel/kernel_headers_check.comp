@@ -26,9 +26,12 @@ void main() {
   acc += resoct_page_encode_mapped(i) ^ resoct_page_encode_homogeneous(i & 0xFFFFu) ^
          RESOCT_PAGE_EMPTY_WORD;
   acc += resoct_page_local_index(uvec3(i, 1u, 2u), uvec3(64u, 4u, 4u));
-  uint key = resoct_request_key_encode(resoct_request_table_id(1u, 2u, 8u), i);
-  acc += resoct_request_key_table(key) + resoct_request_key_local(key) +
-         resoct_request_key_hash(key, 12u);
+  acc += resoct_page_block_index(uvec3(i, 17u, 2u), uvec3(64u, 40u, 4u)) +
+         resoct_page_in_block_index(uvec3(i, 1u, 2u)) + resoct_page_blocks(uvec3(i)).x;
+  uint key = resoct_request_key_brick(resoct_request_table_id(1u, 2u, 8u), i);
+  if (resoct_request_key_is_block_miss(key)) key = resoct_request_key_block_miss(i);
+  acc += resoct_request_key_pool_block(key) + resoct_request_key_in_block(key) +
+         resoct_request_key_directory(key) + resoct_request_key_hash(key, 12u);
   if (key == RESOCT_REQUEST_KEY_NONE) acc = 0u;
   words[i] = acc;
   values[i] = resoct_page_homogeneous_value(e);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::test {
 
@@ -21,7 +22,8 @@ std::uint64_t RecordingBackend::slot_bytes() const noexcept {
 void RecordingBackend::configure(const BackendConfig& config) {
   config_ = config;
   ++configure_calls_;
-  pages_.assign(config.page_entries, 0u);
+  pages_.assign(std::size_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES, 0u);
+  directory_.assign(config.directory_entries, 0u);
   nodes_.assign(config.node_words, 0u);
   voxels_.assign(std::size_t(config.cache_slots * slot_bytes()), std::byte{0});
   updates_.clear();
@@ -37,20 +39,28 @@ void RecordingBackend::update(const FrameUpdate& u) {
     rec.upload_bytes += b.voxels.size();
   }
   if (u.pages_full) {
-    if (u.all_pages.size() != pages_.size() || !u.page_deltas.empty()) {
+    if (u.all_pages.size() > pages_.size() || u.all_directory.size() != directory_.size() ||
+        !u.page_deltas.empty() || !u.directory_deltas.empty()) {
       throw std::logic_error("full page update of the wrong size or with deltas");
     }
-    if (u.page_table_offsets.size() != config_.page_tables + 1u) {
-      throw std::logic_error("page table offsets missing in a full update");
+    if (u.directory_offsets.size() != config_.page_tables + 1u) {
+      throw std::logic_error("directory offsets missing in a full update");
     }
     std::copy(u.all_pages.begin(), u.all_pages.end(), pages_.begin());
-    rec.page_deltas = pages_.size();
+    std::fill(pages_.begin() + std::ptrdiff_t(u.all_pages.size()), pages_.end(), 0u);
+    std::copy(u.all_directory.begin(), u.all_directory.end(), directory_.begin());
+    rec.page_deltas = u.all_pages.size() + directory_.size();
   } else {
     for (const PageDelta& d : u.page_deltas) {
       if (d.index >= pages_.size()) throw std::logic_error("page delta out of range");
       pages_[d.index] = d.value;
     }
-    rec.page_deltas = u.page_deltas.size();
+    for (const PageDelta& d : u.directory_deltas) {
+      if (d.index >= directory_.size() || d.value >= config_.page_pool_blocks)
+        throw std::logic_error("directory delta out of range");
+      directory_[d.index] = d.value;
+    }
+    rec.page_deltas = u.page_deltas.size() + u.directory_deltas.size();
   }
   if (u.nodes_full) {
     if (u.all_nodes.size() != nodes_.size() || !u.node_deltas.empty()) {
@@ -88,11 +98,17 @@ std::span<const std::byte> RecordingBackend::slot_voxels(std::uint32_t slot) con
 void RecordingBackend::want(const PageTable& table, std::span<const PageAddress> bricks,
                             FrameResult& result) {
   for (const PageAddress& a : bricks) {
-    const std::uint32_t entry = pages_.at(table.entry_index(a));
+    const std::uint32_t d = table.directory_index(a);
+    const std::uint32_t block = directory_.at(d);
+    const std::uint32_t in = kernel::resoct_page_in_block_index(a.brick);
+    const std::uint32_t entry =
+        pages_.at(std::size_t(block) * kernel::RESOCT_PAGE_BLOCK_ENTRIES + in);
     if (kernel::resoct_page_is_mapped(entry)) {
       result.used_cache_slots.push_back(kernel::resoct_page_cache_slot(entry));
     } else if (kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED) {
-      result.brick_requests.push_back(Request{table.device_key(a), 1u, a.level});
+      const std::uint32_t key = block == 0u ? kernel::resoct_request_key_block_miss(d)
+                                            : kernel::resoct_request_key_brick(block, in);
+      result.brick_requests.push_back(Request{key, 1u, 0u});
     }
   }
 }

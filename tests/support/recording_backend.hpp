@@ -39,7 +39,9 @@ class RecordingBackend final : public Backend {
   void set_script(Script s) { script_ = std::move(s); }
   const BackendConfig& config() const noexcept { return config_; }
   std::uint32_t configure_calls() const noexcept { return configure_calls_; }
+  /// The page pool mirror (all page_pool_blocks blocks) and the directory mirror.
   const std::vector<std::uint32_t>& pages() const noexcept { return pages_; }
+  const std::vector<std::uint32_t>& directory() const noexcept { return directory_; }
   const std::vector<std::uint32_t>& nodes() const noexcept { return nodes_; }
   std::span<const std::byte> slot_voxels(std::uint32_t slot) const;
   const std::vector<RecordedUpdate>& updates() const noexcept { return updates_; }
@@ -47,13 +49,15 @@ class RecordingBackend final : public Backend {
   std::uint64_t slot_bytes() const noexcept;
 
   /// A minimal kernel model for scripts: for each wanted brick, a MAPPED mirror entry counts as
-  /// a used cache slot, an UNMAPPED one as a request (one hit), EMPTY/HOMOGENEOUS as neither.
+  /// a used cache slot, an UNMAPPED one as a request (one hit; a block-miss key when the mirror's
+  /// block is unallocated, as the kernel reports), EMPTY/HOMOGENEOUS as neither.
   void want(const PageTable& table, std::span<const PageAddress> bricks, FrameResult& result);
 
  private:
   BackendConfig config_;
   std::uint32_t configure_calls_ = 0;
   std::vector<std::uint32_t> pages_;
+  std::vector<std::uint32_t> directory_;
   std::vector<std::uint32_t> nodes_;
   std::vector<std::byte> voxels_;
   std::vector<RecordedUpdate> updates_;

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "resoct/error.hpp"
+#include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::test {
 
@@ -15,7 +16,11 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
   const BrickHierarchy& h = source.hierarchy();
   const VolumeDesc& vol = h.volume();
   const std::uint32_t slots = std::uint32_t(channels.size());
-  pages_ = std::make_unique<PageTable>(h, slots);
+  // Everything may become resident: a pool block for every directory entry.
+  pages_ = std::make_unique<PageTable>(
+      h, slots,
+      std::uint32_t(std::min<std::uint64_t>(PageTable::block_count(h, slots),
+                                            kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS - 1u)));
   for (std::uint32_t s = 0; s < slots; ++s) channels_.assign(s, channels[s], *pages_);
   PageTable* pages = pages_.get();
   octree_ = std::make_unique<ResidencyOctree>(
@@ -77,6 +82,10 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
     uploads_.push_back(
         {p.slot, std::span<const std::byte>(voxels_.data() + p.offset, brick_bytes)});
   }
+  // Every block allocated (the pool holds them all): the kernel reports brick keys, never
+  // block misses, so requests decode to bricks (decode()).
+  for (std::uint32_t d = 0; d < pages_->directory().size() && d < pages_->max_blocks(); ++d)
+    pages_->allocate_block(d);
   pages_->take_deltas();
   octree_->take_deltas();
 }
@@ -87,15 +96,17 @@ void ResidentScene::upload(Backend& backend) const {
   config.voxel_type = h.volume().type;
   config.padded_brick = h.layout().padded_size();
   config.cache_slots = std::max<std::uint32_t>(mapped_bricks(), 1u);
-  config.page_entries = std::uint32_t(pages_->entries().size());
+  config.page_pool_blocks = pages_->pool_block_count();
+  config.directory_entries = std::uint32_t(pages_->directory().size());
   config.page_tables = pages_->table_count();
   config.node_words = octree_->words().size();
   backend.configure(config);
   FrameUpdate u;
   u.bricks = uploads_;
   u.pages_full = true;
-  u.all_pages = pages_->entries();
-  u.page_table_offsets = pages_->table_offsets();
+  u.all_pages = pages_->pool();
+  u.all_directory = pages_->directory();
+  u.directory_offsets = pages_->directory_offsets();
   u.nodes_full = true;
   u.all_nodes = octree_->words();
   backend.update(u);

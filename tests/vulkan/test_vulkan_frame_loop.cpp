@@ -2,8 +2,10 @@
 // cache far smaller than the working set (evictions), the scene's channels swapped in and out of
 // fewer slots (remaps clear page tables and octree slots), and a staging ring of two bricks (every
 // update is split over several submissions). After every frame the device arrays read back must
-// equal the host state: page table and offsets, octree words, and every occupied cache slot
-// holding exactly the padded voxels of the brick the host cache says it holds.
+// equal the host state: page pool, directory and offsets, octree words, and every occupied cache
+// slot holding exactly the padded voxels of the brick the host cache says it holds. A second run
+// uses a page-table pool smaller than the table's blocks, so block misses allocate blocks and
+// the pool is reclaimed, and ends converged with the CPU backend's image.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "vulkan_test_util.hpp"
+#include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
@@ -31,11 +34,16 @@ std::vector<T> words_of(const std::vector<std::byte>& bytes) {
 // Compares every device array with the renderer's host state; returns the occupied slots.
 std::size_t expect_device_matches_host(const Renderer& r, const vk::VulkanBackend& gpu,
                                        const std::string& what) {
-  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)),
-            r.page_table().entries())
+  // The device pool: the host's used prefix, UNMAPPED beyond it.
+  std::vector<std::uint32_t> pool = r.page_table().pool();
+  pool.resize(std::size_t(r.page_table().pool_block_count()) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
+              0u);
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pool) << what;
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory)),
+            r.page_table().directory())
       << what;
-  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::page_offsets)),
-            r.page_table().table_offsets())
+  EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory_offsets)),
+            r.page_table().directory_offsets())
       << what;
   const auto& words = r.octree().words();
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)),
@@ -137,6 +145,64 @@ TEST(VulkanDeltaUploads, ManyFramesWithEvictionAndRemapsMatchTheHostState) {
   EXPECT_GE(remaps, 4u);
   EXPECT_GT(page_deltas, 0u);
   EXPECT_GT(node_deltas, 0u);
+  expect_no_validation_messages(*gpu);
+}
+
+TEST(VulkanDeltaUploads, BlockAllocationAndReclaimMatchTheHostStateAndConverge) {
+  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  // 4^3 bricks over 512^3: level 0 is 128^3 bricks in 8^3 blocks, 589 blocks over all levels.
+  BrickLayout layout;
+  layout.brick_size = glm::uvec3(4);
+  layout.halo = 1;
+  auto source = std::make_shared<ProceduralSource>("procedural:sphere:512x512x512", layout);
+  const std::uint64_t slot_bytes = layout.padded_voxels() * voxel_size(source->volume().type);
+  vk::register_backend();
+  RendererOptions o;
+  o.backend = "vulkan";
+  o.backend_options.validation = true;
+  o.loader_threads = 0;
+  o.leaf_size = glm::uvec3(16);
+  o.device_cache_bytes = 24 * slot_bytes;
+  o.page_pool_blocks = 25;  // above the cache slots, far below the table's 589 blocks
+  ASSERT_EQ(PageTable::block_count(source->hierarchy(), 1), 589u);
+  Renderer r(source, o);
+  auto* gpu = dynamic_cast<vk::VulkanBackend*>(&r.backend());
+  ASSERT_NE(gpu, nullptr);
+  Scene s = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/sphere.json");
+  s.viewport = Viewport{16, 16};
+  std::uint64_t misses = 0, freed = 0;
+  std::vector<std::uint32_t> last_dir = r.page_table().directory();
+  for (int frame = 0; frame < 16; ++frame) {
+    const double a = 0.7 * frame;
+    // Close to the volume: the finest levels of the blocks near the eye are needed.
+    s.camera.eye = {0.5 + 0.7 * std::cos(a), 0.5 + 0.7 * std::sin(a), 0.55};
+    const FrameReport rep = r.render_frame(s);
+    misses += rep.stats.block_misses;
+    const auto& dir = r.page_table().directory();
+    for (std::size_t d = 0; d < dir.size(); ++d) freed += last_dir[d] != 0 && dir[d] == 0 ? 1 : 0;
+    last_dir = dir;
+    expect_device_matches_host(r, *gpu, "frame " + std::to_string(frame));
+    if (HasFailure()) break;
+  }
+  EXPECT_GT(misses, 0u);
+  EXPECT_GT(freed, 0u) << "the pool was never reclaimed";
+  // Converges at a still view (a working set within the 24 slots), with the image of the CPU
+  // backend run the same way.
+  s.camera.eye = {1.6, 1.3, 1.9};
+  s.viewport = Viewport{8, 8};
+  const ConvergeReport done = r.render_until_converged(s, 48);
+  ASSERT_TRUE(done.converged) << done.frames << " frames";
+  expect_device_matches_host(r, *gpu, "converged");
+  cpu::register_backend();
+  RendererOptions oc = o;
+  oc.backend = "cpu";
+  oc.backend_options = BackendOptions{};
+  oc.backend_options.threads = 1;
+  Renderer rc(source, oc);
+  const ConvergeReport cpu_done = rc.render_until_converged(s, 48);
+  ASSERT_TRUE(cpu_done.converged);
+  const ImageDiff d = compare_images(done.last.image, cpu_done.last.image);
+  for (int ch = 0; ch < 4; ++ch) EXPECT_LE(d.max_abs[ch], 2e-3) << "channel " << ch;
   expect_no_validation_messages(*gpu);
 }
 

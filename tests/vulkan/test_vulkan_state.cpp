@@ -27,7 +27,8 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
   cfg.voxel_type = type;
   cfg.padded_brick = {5, 3, 7};  // odd sizes: u8/u16 bricks straddle 32-bit words
   cfg.cache_slots = 13;
-  cfg.page_entries = 777;
+  cfg.page_pool_blocks = 3;  // 3 x 4096 pool words
+  cfg.directory_entries = 777;
   cfg.page_tables = 6;
   cfg.node_words = 1001;
   cfg.brick_request_capacity = 100;
@@ -36,11 +37,14 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
 
   const std::size_t brick_bytes = 5u * 3u * 7u * voxel_size(type);
   std::vector<std::byte> cache(cfg.cache_slots * brick_bytes, std::byte{0});
-  std::vector<std::uint32_t> pages(cfg.page_entries, 0), offsets(cfg.page_tables + 1u, 0);
+  std::vector<std::uint32_t> pages(cfg.page_pool_blocks * 4096u, 0),
+      offsets(cfg.page_tables + 1u, 0);
+  std::vector<std::uint32_t> dir(cfg.directory_entries, 0);
   std::vector<std::uint32_t> nodes(cfg.node_words, 0);
   // configure() leaves every array zero.
   EXPECT_EQ(gpu.debug_read(vk::DeviceArray::cache), cache);
   EXPECT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pages);
+  EXPECT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory)), dir);
   EXPECT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)), nodes);
 
   std::mt19937 rng(seed);
@@ -49,9 +53,9 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
     FrameUpdate u;
     std::vector<std::vector<std::byte>> brick_data;
     std::vector<BrickUpload> uploads;
-    std::vector<PageDelta> pd;
+    std::vector<PageDelta> pd, dd;
     std::vector<OctreeWordDelta> nd;
-    std::vector<std::uint32_t> all_pages, all_offsets, all_nodes;
+    std::vector<std::uint32_t> all_pages, all_dir, all_offsets, all_nodes;
     const int nb = int(rng() % 4);
     for (int i = 0; i < nb; ++i) {
       std::vector<std::byte> v(brick_bytes);
@@ -64,15 +68,21 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
       std::memcpy(cache.data() + slot * brick_bytes, v.data(), brick_bytes);
     }
     if (round % 17 == 0) {
-      all_pages.resize(pages.size());
+      // A prefix of the pool (the rest must read 0), the whole directory, the offsets.
+      all_pages.resize(pick(pages.size() + 1));
       for (auto& p : all_pages) p = std::uint32_t(rng());
+      all_dir.resize(dir.size());
+      for (auto& d : all_dir) d = pick(cfg.page_pool_blocks);
       all_offsets.resize(offsets.size());
-      for (auto& o : all_offsets) o = pick(pages.size() + 1);
-      pages = all_pages;
+      for (auto& o : all_offsets) o = pick(dir.size() + 1);
+      std::fill(pages.begin(), pages.end(), 0u);
+      std::copy(all_pages.begin(), all_pages.end(), pages.begin());
+      dir = all_dir;
       offsets = all_offsets;
       u.pages_full = true;
       u.all_pages = all_pages;
-      u.page_table_offsets = all_offsets;
+      u.all_directory = all_dir;
+      u.directory_offsets = all_offsets;
     }
     if (round % 23 == 5) {
       all_nodes.resize(nodes.size());
@@ -87,18 +97,26 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
       pages[d.index] = d.value;  // later deltas of the same index win
     }
     for (int i = int(rng() % 40); i > 0; --i) {
+      PageDelta d{pick(dir.size()), pick(cfg.page_pool_blocks)};
+      dd.push_back(d);
+      dir[d.index] = d.value;
+    }
+    for (int i = int(rng() % 40); i > 0; --i) {
       OctreeWordDelta d{pick(nodes.size()), std::uint32_t(rng())};
       nd.push_back(d);
       nodes[d.index] = d.value;
     }
     u.bricks = uploads;
     u.page_deltas = pd;
+    u.directory_deltas = dd;
     u.node_deltas = nd;
     gpu.update(u);
     if (round % 10 == 9) {
       ASSERT_EQ(gpu.debug_read(vk::DeviceArray::cache), cache) << "round " << round;
       ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pages);
-      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::page_offsets)), offsets);
+      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory)), dir);
+      ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory_offsets)),
+                offsets);
       ASSERT_EQ(as_words<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)), nodes);
     }
   }
@@ -125,7 +143,8 @@ TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
   BackendConfig cfg;
   cfg.padded_brick = {4, 4, 4};
   cfg.cache_slots = 2;
-  cfg.page_entries = 8;
+  cfg.page_pool_blocks = 1;
+  cfg.directory_entries = 8;
   cfg.page_tables = 1;
   cfg.node_words = 8;
   gpu->configure(cfg);
@@ -134,10 +153,15 @@ TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
   FrameUpdate u;
   u.bricks = {&up, 1};
   EXPECT_RESOCT_ERROR(gpu->update(u), ErrorCode::invalid_argument, "update");
-  const PageDelta far{8, 1};
+  const PageDelta far{4096, 1};
   FrameUpdate v;
   v.page_deltas = {&far, 1};
   EXPECT_RESOCT_ERROR(gpu->update(v), ErrorCode::invalid_argument, "page delta");
+  for (const PageDelta bad : {PageDelta{8, 0}, PageDelta{0, 1}}) {
+    FrameUpdate w;
+    w.directory_deltas = {&bad, 1};
+    EXPECT_RESOCT_ERROR(gpu->update(w), ErrorCode::invalid_argument, "directory delta");
+  }
   FrameTables t;
   FrameResult r;
   EXPECT_RESOCT_ERROR(gpu->render(t, r), ErrorCode::invalid_argument, "tables");

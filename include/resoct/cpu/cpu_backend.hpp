@@ -49,8 +49,9 @@ class CpuBackend : public Backend {
   std::size_t voxel_bytes_ = 1;
   std::size_t slot_voxels_ = 0;
   std::vector<std::byte> cache_;
-  std::vector<std::uint32_t> pages_;
-  std::vector<std::uint32_t> page_offsets_;
+  std::vector<std::uint32_t> pages_;  // the page pool
+  std::vector<std::uint32_t> directory_;
+  std::vector<std::uint32_t> directory_offsets_;
   std::vector<std::uint32_t> nodes_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> used_bits_;
   std::size_t used_words_ = 0;

@@ -75,6 +75,34 @@ RESOCT_FN uint resoct_page_local_index(uvec3 brick, uvec3 bricks) {
   return brick.x + bricks.x * (brick.y + bricks.y * brick.z);
 }
 
+// The sparse two-level layout: each (slot, level) table is cut into blocks of 16^3 bricks; a
+// per-table directory (x fastest over the table's block grid) holds one pool block index per
+// block, and pool block b holds the 4096 entries of its block at words [b * 4096, b * 4096 +
+// 4096), x fastest. Pool block 0 is permanently all UNMAPPED, so a directory word of 0 means
+// "not allocated" and the lookup needs no branch.
+RESOCT_CONST(uint, RESOCT_PAGE_BLOCK_LOG2, 4u);  // bricks per block axis: 16
+RESOCT_CONST(uint, RESOCT_PAGE_BLOCK_MASK, 15u);
+RESOCT_CONST(uint, RESOCT_PAGE_BLOCK_ENTRIES_LOG2, 12u);
+RESOCT_CONST(uint, RESOCT_PAGE_BLOCK_ENTRIES, 4096u);
+
+// Blocks per axis of a table with `bricks` bricks per axis.
+RESOCT_FN uvec3 resoct_page_blocks(uvec3 bricks) {
+  return (bricks + uvec3(RESOCT_PAGE_BLOCK_MASK)) >> uvec3(RESOCT_PAGE_BLOCK_LOG2);
+}
+
+// Index of a brick's block within its table's directory (x fastest).
+RESOCT_FN uint resoct_page_block_index(uvec3 brick, uvec3 bricks) {
+  uvec3 n = resoct_page_blocks(bricks);
+  uvec3 b = brick >> uvec3(RESOCT_PAGE_BLOCK_LOG2);
+  return b.x + n.x * (b.y + n.y * b.z);
+}
+
+// Index of a brick's entry within its pool block (x fastest).
+RESOCT_FN uint resoct_page_in_block_index(uvec3 brick) {
+  uvec3 i = brick & uvec3(RESOCT_PAGE_BLOCK_MASK);
+  return i.x | (i.y << RESOCT_PAGE_BLOCK_LOG2) | (i.z << (2u * RESOCT_PAGE_BLOCK_LOG2));
+}
+
 RESOCT_KERNEL_END
 
 #endif  // RESOCT_KERNEL_PAGE_ENTRY_GLSL_H

@@ -9,7 +9,8 @@
 // never needs a neighbour brick.
 //
 // Accessors the including file must define BEFORE including (see traverse.glsl.h):
-//   uint  resoct_read_page(uint index), uint resoct_read_page_table_offset(uint table),
+//   uint  resoct_read_page(uint index), uint resoct_read_directory(uint index),
+//   uint  resoct_read_directory_offset(uint table),
 //   float resoct_sample_cache(uint cache_slot, vec3 pos), void resoct_mark_used(uint cache_slot)
 #ifndef RESOCT_KERNEL_SAMPLE_GLSL_H
 #define RESOCT_KERNEL_SAMPLE_GLSL_H
@@ -32,23 +33,30 @@ RESOCT_FN uvec3 resoct_brick_at(ResoctLevelInfo L, uvec3 brick_size, ivec3 cell)
   return min(v / brick_size, uvec3(L.bricks_x - 1u, L.bricks_y - 1u, L.bricks_z - 1u));
 }
 
-/// Local index of a brick within its (slot, level) table.
-RESOCT_FN uint resoct_brick_local(ResoctLevelInfo L, uvec3 brick) {
-  return resoct_page_local_index(brick, uvec3(L.bricks_x, L.bricks_y, L.bricks_z));
+/// Global directory index of the block holding a brick of (slot, level).
+RESOCT_FN uint resoct_page_directory_index(uint slot, uint level, uint level_count,
+                                           ResoctLevelInfo L, uvec3 brick) {
+  return resoct_read_directory_offset(resoct_request_table_id(slot, level, level_count)) +
+         resoct_page_block_index(brick, uvec3(L.bricks_x, L.bricks_y, L.bricks_z));
 }
 
-/// The page entry of a brick of (slot, level).
+/// The page entry of a brick of (slot, level): directory, then pool (block 0 reads UNMAPPED).
 RESOCT_FN uint resoct_page_entry_of(uint slot, uint level, uint level_count, ResoctLevelInfo L,
                                     uvec3 brick) {
-  uint table = resoct_request_table_id(slot, level, level_count);
-  return resoct_read_page(resoct_read_page_table_offset(table) + resoct_brick_local(L, brick));
+  uint block =
+      resoct_read_directory(resoct_page_directory_index(slot, level, level_count, L, brick));
+  return resoct_read_page((block << RESOCT_PAGE_BLOCK_ENTRIES_LOG2) |
+                          resoct_page_in_block_index(brick));
 }
 
-/// Device request key of a brick of (slot, level).
+/// Device request key of a brick of (slot, level): the brick key when its block is allocated,
+/// else the block-miss key of the block (kernel/request_key.glsl.h).
 RESOCT_FN uint resoct_brick_request_key(uint slot, uint level, uint level_count, ResoctLevelInfo L,
                                         uvec3 brick) {
-  return resoct_request_key_encode(resoct_request_table_id(slot, level, level_count),
-                                   resoct_brick_local(L, brick));
+  uint d = resoct_page_directory_index(slot, level, level_count, L, brick);
+  uint block = resoct_read_directory(d);
+  return block == 0u ? resoct_request_key_block_miss(d)
+                     : resoct_request_key_brick(block, resoct_page_in_block_index(brick));
 }
 
 /// Continuous padded-brick coordinate of a level-0 position in a brick of level L.

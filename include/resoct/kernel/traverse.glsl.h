@@ -5,8 +5,9 @@
 // resoct::kernel, after including frame.glsl.h for the record types; GLSL: at global scope,
 // typically over storage buffers):
 //   uint  resoct_read_node(uint index)               octree word (kernel/octree_node.glsl.h)
-//   uint  resoct_read_page(uint index)               page-table entry (kernel/page_entry.glsl.h)
-//   uint  resoct_read_page_table_offset(uint table)  first entry of (slot, level) table
+//   uint  resoct_read_page(uint index)               page pool word (kernel/page_entry.glsl.h)
+//   uint  resoct_read_directory(uint index)          pool block of a directory entry
+//   uint  resoct_read_directory_offset(uint table)   first directory entry of (slot, level) table
 //   ResoctSlotInfo  resoct_read_slot(uint i)          slot table, importance order
 //   ResoctLevelInfo resoct_read_level(uint l)
 //   ResoctDepthInfo resoct_read_depth(uint d)

@@ -26,7 +26,9 @@ namespace resoct::vk {
 void register_backend();
 
 /// Device arrays a test can read back (debug_read()).
-enum class DeviceArray : std::uint8_t { cache, pages, page_offsets, nodes };
+/// `pages` is the page pool, `directory` and `directory_offsets` the sparse page table's
+/// directory (include/resoct/page_table.hpp).
+enum class DeviceArray : std::uint8_t { cache, pages, directory, directory_offsets, nodes };
 
 /// Not thread-safe: one Renderer drives it from one thread. update() copies its input into the
 /// staging ring and render() waits for the device, so the host may reuse its spans as soon as a

@@ -49,11 +49,16 @@ layout(std430, binding = 3) readonly buffer Depths {
 layout(std430, binding = 4) readonly buffer Nodes {
   uint nodes[];
 };
+// The sparse page table (kernel/page_entry.glsl.h): pool blocks of 4096 entries, the directory
+// of pool block indices (binding 21) and the first directory entry of each (slot, level) table.
 layout(std430, binding = 5) readonly buffer Pages {
   uint pages[];
 };
-layout(std430, binding = 6) readonly buffer PageOffsets {
-  uint page_offsets[];
+layout(std430, binding = 6) readonly buffer DirectoryOffsets {
+  uint directory_offsets[];
+};
+layout(std430, binding = 21) readonly buffer Directory {
+  uint directory[];
 };
 layout(std430, binding = 7) readonly buffer TfLuts {
   vec4 tf_entries[];
@@ -151,8 +156,11 @@ uint resoct_read_node(uint index) {
 uint resoct_read_page(uint index) {
   return pages[index];
 }
-uint resoct_read_page_table_offset(uint table) {
-  return page_offsets[table];
+uint resoct_read_directory(uint index) {
+  return directory[index];
+}
+uint resoct_read_directory_offset(uint table) {
+  return directory_offsets[table];
 }
 ResoctSlotInfo resoct_read_slot(uint i) {
   return slots[i];
