@@ -190,13 +190,21 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       float skip_exit = RESOCT_RAY_T_INF;
 
       if (f.mode == RESOCT_MODE_RESIDENCY) {
-        // This sample's traversal depth: the ray's, capped at the depth of the LOD level's
-        // "leaves" (kernel/node_class.glsl.h); the level changes rarely along a ray.
-        if (lod != cap_lod) {
+        // This sample's traversal depth: the ray's, capped at the depth of the "leaves" of the
+        // finest level a live channel samples here (kernel/node_class.glsl.h). The LOD level
+        // changes rarely along a ray; a new segment (cached_node reset) may change the bank.
+        if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
           cap_lod = lod;
-          cap_depth =
-              min(trav_depth, resoct_level_depth_cap(f.start_depth, f.depth_count,
-                                                     resoct_level_factor(resoct_read_level(lod))));
+          uint cap_level = RESOCT_NONE_U;
+          for (uint c = 0u; c < n; ++c) {
+            if (((live >> c) & 1u) == 0u) continue;
+            ResoctSlotInfo s = resoct_read_slot(bank + c);
+            cap_level = min(cap_level, resoct_channel_level(lod, s.finest_level, s.coarsest_level));
+          }
+          if (cap_level == RESOCT_NONE_U) cap_level = lod;
+          cap_depth = min(trav_depth, resoct_level_depth_cap(
+                                          f.start_depth, f.depth_count,
+                                          resoct_level_factor(resoct_read_level(cap_level))));
         }
         // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
         bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
