@@ -129,23 +129,23 @@ std::uint32_t depth_with_nodes_of(const OctreeLayout& layout, glm::u64vec3 need)
   return best;
 }
 
-// All channels sample level 2 or coarser: the traversal stops at nodes of leaf << 2 voxels (the
-// leaves a tree over level-2 voxels would have), classifying at most that many depths per
-// position, and it skips only invisible samples: the page-table image, which skips nothing but
-// EMPTY bricks. (Descending to the 4³ leaves, as before the cap, skipped coarse samples whose
-// trilinear footprint reaches visible neighbours: 5.6e-3 off the page-table image.)
-TEST(CpuTraversalDepth, CoarseLevelsCapTheDepthWithoutSkippingVisibleSamples) {
-  ProceduralSource src("procedural:tubes:128x128x128", bricks8());
+// All channels sample level 2 or coarser and steps are about a level-0 voxel: without the cap the
+// traversal would descend to the 2³ leaves. Capped, it stops at nodes of two level-2 voxels (8³,
+// one trilinear footprint of the sampled level): at most cap + 1 nodes per position, and the same
+// samples, brick reads and image as a render that classifies those nodes without a descent
+// (start_depth = cap).
+TEST(CpuTraversalDepth, CoarseLevelsCapTheDepth) {
+  ProceduralSource src("procedural:tubes:64x64x64", bricks8());
   ResidentOptions ro;
-  ro.leaf_size = glm::uvec3(4);
+  ro.leaf_size = glm::uvec3(2);
   ResidentScene rs(src, {0}, ro);
   ASSERT_GE(src.hierarchy().level_count(), 3u);
-  const std::uint32_t cap = depth_with_nodes_of(rs.layout(), glm::u64vec3(16));
-  ASSERT_LT(cap, rs.layout().leaf_depth());
+  const std::uint32_t cap = depth_with_nodes_of(rs.layout(), glm::u64vec3(8));
+  ASSERT_LT(cap + 1, rs.layout().leaf_depth());
   std::mt19937 rng(99u);
   for (int view = 0; view < 3; ++view) {
     Scene s = make_scene(32, random_camera(rng));
-    s.step_scale = 1.0;
+    s.step_scale = 0.25;
     s.channels = {make_channel(0,
                                {{0.0, {1, 1, 1, 0}},
                                 {0.1, {1, 1, 1, 0}},
@@ -154,10 +154,12 @@ TEST(CpuTraversalDepth, CoarseLevelsCapTheDepthWithoutSkippingVisibleSamples) {
                                2, 15)};
     FrameOptions o;
     const Rendered res = render_cpu(rs, s, o);
-    o.mode = RenderMode::pagetable;
-    const Rendered pt = render_cpu(rs, s, o);
-    EXPECT_LT(max_diff(res.image, pt.image), 1e-4) << view;
+    o.start_depth = cap;
+    const Rendered flat = render_cpu(rs, s, o);
     ASSERT_GT(res.stats.samples, 0u);
+    EXPECT_EQ(res.stats.samples, flat.stats.samples) << view;
+    EXPECT_EQ(res.stats.brick_accesses, flat.stats.brick_accesses) << view;
+    EXPECT_LT(max_diff(res.image, flat.image), 1e-4) << view;
     EXPECT_LE(res.stats.nodes_visited, res.stats.iterations * (cap + 1))
         << view << ": " << res.stats.nodes_visited << " nodes, " << res.stats.iterations
         << " positions";

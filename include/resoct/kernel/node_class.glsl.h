@@ -126,18 +126,16 @@ RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, Resoct
   return cls;
 }
 
-/// Deepest depth (at least `start_depth`) whose nodes are at least as large as a leaf scaled by
-/// the voxel size of a level with factors `factor_log2`: the depth a leaf would have if the tree
-/// were built over that level's voxels. Sampling a coarse level, finer nodes would only split
-/// that level's voxels, so the traversal stops there (docs/rendering.md "Traversal depth").
+/// Deepest depth (at least `start_depth`) whose nodes span at least two voxels per axis of a
+/// level with factors `factor_log2`: the extent of one trilinear sample of that level. A smaller
+/// node cannot be classified for such a sample (its value depends on voxels beyond the node), and
+/// descending to it only adds node visits that grow with the data at a fixed view.
 RESOCT_FN uint resoct_level_depth_cap(uint start_depth, uint depth_count, uvec3 factor_log2) {
-  ResoctDepthInfo leaf = resoct_read_depth(depth_count - 1u);
   uint depth = start_depth;
   for (uint d = start_depth + 1u; d < depth_count; ++d) {
     ResoctDepthInfo D = resoct_read_depth(d);
-    if ((D.node_extent_x >> factor_log2.x) < leaf.node_extent_x ||
-        (D.node_extent_y >> factor_log2.y) < leaf.node_extent_y ||
-        (D.node_extent_z >> factor_log2.z) < leaf.node_extent_z) {
+    if ((D.node_extent_x >> factor_log2.x) < 2u || (D.node_extent_y >> factor_log2.y) < 2u ||
+        (D.node_extent_z >> factor_log2.z) < 2u) {
       break;
     }
     depth = d;
