@@ -190,9 +190,10 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       float skip_exit = RESOCT_RAY_T_INF;
 
       if (f.mode == RESOCT_MODE_RESIDENCY) {
-        // This sample's traversal depth: the ray's, capped at the depth of the "leaves" of the
-        // finest level a live channel samples here (kernel/node_class.glsl.h). The LOD level
-        // changes rarely along a ray; a new segment (cached_node reset) may change the bank.
+        // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
+        // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
+        // The LOD level changes rarely along a ray; a new segment (cached_node reset) may
+        // change the bank and with it the channels' level ranges.
         if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
           cap_lod = lod;
           uint cap_level = RESOCT_NONE_U;
