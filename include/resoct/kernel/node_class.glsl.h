@@ -20,6 +20,9 @@ RESOCT_CONST(uint, RESOCT_NODE_CLASS_HOMOGENEOUS, 3u);
 
 RESOCT_CONST(uint, RESOCT_NONE_U, 0xFFFFFFFFu);
 
+/// Most depths a layout can have (OctreeLayout::kMaxNodes = 2^31, each depth at least doubles).
+RESOCT_CONST(uint, RESOCT_MAX_DEPTHS, 32u);
+
 /// Child bits of a node coordinate at depth D: the low coordinate bit of each split axis, z then
 /// y then x with x least significant (OctreeLayout's order).
 RESOCT_FN uint resoct_node_child_bits(ResoctDepthInfo D, uvec3 c) {
@@ -105,21 +108,39 @@ RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
   return resoct_read_depth(depth).first_node + local;
 }
 
-/// Class of a channel at the node of depth `depth` on the path to (coord, coord_log2): its own
-/// record if it has metadata, else that of the nearest ancestor (down to `top`) that has, since a
-/// parent's record covers its children; INVALID when none has.
-RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
-                                         uvec3 coord_log2, ResoctSlotInfo s, uint node_slots) {
+/// Class of a channel at the node of depth `depth`: its own record if it has metadata, else that
+/// of the nearest ancestor (down to `top`) that has, since a parent's record covers its children;
+/// INVALID when none has. Walks up by shifting the node's local index (a parent's local index is
+/// the child's without its child bits), so the walk is O(depth), not O(depth^2).
+RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, ResoctSlotInfo s,
+                                         uint node_slots) {
   uint cls = resoct_node_class(node, s, node_slots);
+  if (cls != RESOCT_NODE_CLASS_INVALID) return cls;
   uint d = depth;
+  uint local = node - resoct_read_depth(d).first_node;
   while (cls == RESOCT_NODE_CLASS_INVALID && d > top) {
+    local = local >> resoct_read_depth(d).child_shift;
     d = d - 1u;
-    ResoctDepthInfo D = resoct_read_depth(d);
-    cls = resoct_node_class(resoct_node_index(d, resoct_ancestor_coord(D, coord, coord_log2),
-                                              resoct_depth_count_log2(D)),
-                            s, node_slots);
+    cls = resoct_node_class(resoct_read_depth(d).first_node + local, s, node_slots);
   }
   return cls;
+}
+
+/// Deepest depth (at least `start_depth`) whose nodes span at least two voxels per axis of a
+/// level with factors `factor_log2`: the extent of one trilinear sample of that level. A smaller
+/// node cannot be classified for such a sample (its value depends on voxels beyond the node), and
+/// descending to it only adds node visits that grow with the data at a fixed view.
+RESOCT_FN uint resoct_level_depth_cap(uint start_depth, uint depth_count, uvec3 factor_log2) {
+  uint depth = start_depth;
+  for (uint d = start_depth + 1u; d < depth_count; ++d) {
+    ResoctDepthInfo D = resoct_read_depth(d);
+    if ((D.node_extent_x >> factor_log2.x) < 2u || (D.node_extent_y >> factor_log2.y) < 2u ||
+        (D.node_extent_z >> factor_log2.z) < 2u) {
+      break;
+    }
+    depth = d;
+  }
+  return depth;
 }
 
 RESOCT_KERNEL_END

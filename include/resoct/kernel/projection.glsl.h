@@ -50,22 +50,18 @@ RESOCT_FN uint resoct_projection_node_class(uint node, ResoctSlotInfo s, uint no
 
 /// As resoct_node_class_carried, for any channel mode: projection channels by value, the others
 /// by their visible range. `beat` is the channel's running projection value.
-RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top, uvec3 coord,
-                                              uvec3 coord_log2, ResoctSlotInfo s, uint node_slots,
-                                              float beat) {
-  if (!resoct_is_projection(s)) {
-    return resoct_node_class_carried(node, depth, top, coord, coord_log2, s, node_slots);
-  }
+RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top, ResoctSlotInfo s,
+                                              uint node_slots, float beat) {
+  if (!resoct_is_projection(s)) return resoct_node_class_carried(node, depth, top, s, node_slots);
   uint thr = resoct_projection_threshold16(s, beat);
   uint cls = resoct_projection_node_class(node, s, node_slots, thr);
+  if (cls != RESOCT_NODE_CLASS_INVALID) return cls;
   uint d = depth;
+  uint local = node - resoct_read_depth(d).first_node;
   while (cls == RESOCT_NODE_CLASS_INVALID && d > top) {
+    local = local >> resoct_read_depth(d).child_shift;
     d = d - 1u;
-    ResoctDepthInfo D = resoct_read_depth(d);
-    cls = resoct_projection_node_class(
-        resoct_node_index(d, resoct_ancestor_coord(D, coord, coord_log2),
-                          resoct_depth_count_log2(D)),
-        s, node_slots, thr);
+    cls = resoct_projection_node_class(resoct_read_depth(d).first_node + local, s, node_slots, thr);
   }
   return cls;
 }

@@ -91,8 +91,7 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
         ResoctSlotInfo s = resoct_read_slot(c);
         uint cls = RESOCT_NODE_CLASS_EMPTY;
         if (((live >> c) & 1u) != 0u && !resoct_is_projection(s)) {
-          cls = resoct_node_class_carried(node, depth, p.start_depth, coord, dlog2, s,
-                                          sp.node_slot_count);
+          cls = resoct_node_class_carried(node, depth, p.start_depth, s, sp.node_slot_count);
           // A homogeneous ancestor's value is only known at the ancestor: read bricks.
           if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS &&
               resoct_node_class(node, s, sp.node_slot_count) != RESOCT_NODE_CLASS_HOMOGENEOUS) {

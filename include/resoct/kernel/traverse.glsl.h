@@ -101,19 +101,31 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   float dt = resoct_step_size(dir_box, finest, f.step_scale, f.min_step);
   uint trav_depth = resoct_traversal_depth(f, dt);
   ResoctSampleParams sp = resoct_sample_params(f);
-  ResoctDepthInfo trav_info = resoct_read_depth(trav_depth);
-  uvec3 trav_log2 = resoct_depth_count_log2(trav_info);
 
   uint last_key[RESOCT_MAX_SLOTS];
   for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) last_key[i] = RESOCT_REQUEST_KEY_NONE;
   uint last_node_request = RESOCT_NONE_U;
 
-  // Residency mode: classification of the last traversal node, reused while samples stay in it.
+  // Residency mode: classification of the last traversal node (depth cached_depth, level-0 box
+  // [cached_lo, cached_hi)), reused while samples stay in it. RESOCT_NONE_U in cached_node (also
+  // set by resoct_segment_advance when the bank changes) drops it and the descent path.
   uint cached_node = RESOCT_NONE_U;
   uvec3 cached_coord = uvec3(RESOCT_NONE_U);
+  uint cached_depth = 0u;
+  ivec3 cached_lo = ivec3(0);
+  ivec3 cached_hi = ivec3(0);
   uint cached_empty = 0u;
   uint cached_homog = 0u;
   uint cached_skip_depth = RESOCT_NONE_U;
+  // The last descent's path: per depth d in [start_depth, path_end] the node's local index and
+  // the channels found empty down to it; path_skip = 1 when every channel was empty at path_end.
+  uint path_local[RESOCT_MAX_DEPTHS];
+  uint path_empty[RESOCT_MAX_DEPTHS];
+  uint path_end = RESOCT_NONE_U;
+  uint path_skip = 0u;
+  // The traversal depth capped for the LOD level cap_lod (RESOCT_NONE_U: not computed yet).
+  uint cap_lod = RESOCT_NONE_U;
+  uint cap_depth = trav_depth;
 
   // Effects: per-ray state and constants (only touched by specializations that use them).
   ResoctFxRay fx;
@@ -179,59 +191,110 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       float skip_exit = RESOCT_RAY_T_INF;
 
       if (f.mode == RESOCT_MODE_RESIDENCY) {
-        uvec3 trav_coord = resoct_node_coord(trav_info, cell);
-        // Consecutive samples mostly stay in one node: skip the index walk then.
-        bool same_node = all(equal(trav_coord, cached_coord));
-        uint node = same_node ? cached_node : resoct_node_index(trav_depth, trav_coord, trav_log2);
-        cached_coord = trav_coord;
-        if (node != cached_node) {
+        // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
+        // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
+        // The LOD level changes rarely along a ray; a new segment (cached_node reset) may
+        // change the bank and with it the channels' level ranges.
+        if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
+          cap_lod = lod;
+          uint cap_level = RESOCT_NONE_U;
+          for (uint c = 0u; c < n; ++c) {
+            if (((live >> c) & 1u) == 0u) continue;
+            ResoctSlotInfo s = resoct_read_slot(bank + c);
+            cap_level = min(cap_level, resoct_channel_level(lod, s.finest_level, s.coarsest_level));
+          }
+          if (cap_level == RESOCT_NONE_U) cap_level = lod;
+          cap_depth = min(trav_depth, resoct_level_depth_cap(
+                                          f.start_depth, f.depth_count,
+                                          resoct_level_factor(resoct_read_level(cap_level))));
+        }
+        // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
+        bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
+                         all(greaterThanEqual(cell, cached_lo)) && all(lessThan(cell, cached_hi));
+        if (!same_node) {
+          ResoctDepthInfo Dt = resoct_read_depth(cap_depth);
+          uvec3 trav_coord = resoct_node_coord(Dt, cell);
+          uvec3 trav_log2 = resoct_depth_count_log2(Dt);
+          uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
+          cached_lo = ivec3(trav_coord * ne);
+          cached_hi = cached_lo + ivec3(ne);
+          cached_coord = trav_coord;
           // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
-          // node advances the channel index in the same node.
-          cached_node = node;
-          cached_empty = 0u;
+          // node advances the channel index in the same node. `state` = channels empty so far
+          // (always channels 0 .. ci - 1). The descent restarts below the deepest node it
+          // shares with the previous descent's path (whose results depend only on that node and
+          // its ancestors), except for projection channels, whose class follows the running
+          // value along the ray.
+          uint reuse_end = cached_node == RESOCT_NONE_U ? RESOCT_NONE_U : path_end;
+          RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+            reuse_end = RESOCT_NONE_U;
+          }
+          bool on_path = reuse_end != RESOCT_NONE_U;
+          cached_depth = cap_depth;
           cached_homog = 0u;
           cached_skip_depth = RESOCT_NONE_U;
-          uint ci = 0u;
+          uint state = 0u;
           uint local = 0u;
-          for (uint d = 0u; d <= trav_depth; ++d) {
+          for (uint d = 0u; d <= cap_depth; ++d) {
             ResoctDepthInfo D = resoct_read_depth(d);
             if (d > 0u) {
               local = (local << D.child_shift) |
                       resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
             }
             if (d < f.start_depth) continue;
-            uint nd = D.first_node + local;
+            if (on_path && d <= reuse_end && path_local[d] == local) {
+              state = path_empty[d];
+              if (d == reuse_end && path_skip != 0u) {
+                cached_skip_depth = d;
+                break;
+              }
+              continue;
+            }
+            // From here on the path differs from the previous one: drop its deeper entries.
+            on_path = false;
+            path_local[d] = local;
+            path_end = d > f.start_depth ? d - 1u : RESOCT_NONE_U;
+            path_skip = 0u;
+            if (d == cap_depth) break;  // the traversal node: classified below
             stats.nodes = stats.nodes + 1u;
+            uint nd = D.first_node + local;
+            uint ci = uint(bitCount(state));
             while (ci < n) {
               bool empty = ((live >> ci) & 1u) == 0u;
               if (!empty) {
                 uint cls;
                 RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                  cls = resoct_mode_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
+                  cls = resoct_mode_node_class_carried(nd, d, f.start_depth,
                                                        resoct_read_slot(bank + ci),
                                                        f.node_slot_count, fx.proj[ci]);
                 }
                 else {
-                  cls = resoct_node_class_carried(nd, d, f.start_depth, trav_coord, trav_log2,
-                                                  resoct_read_slot(bank + ci), f.node_slot_count);
+                  cls = resoct_node_class_carried(nd, d, f.start_depth, resoct_read_slot(bank + ci),
+                                                  f.node_slot_count);
                 }
                 empty = cls == RESOCT_NODE_CLASS_EMPTY;
               }
               if (!empty) break;
-              cached_empty = cached_empty | (1u << ci);
+              state = state | (1u << ci);
               ci = ci + 1u;
             }
+            path_empty[d] = state;
+            path_end = d;
+            path_skip = ci == n ? 1u : 0u;
             if (ci == n) {
               cached_skip_depth = d;
               break;
             }
           }
+          cached_empty = state;
           if (cached_skip_depth == RESOCT_NONE_U) {
             // The remaining channels at the traversal node. A node whose own record is INVALID
             // is requested; its class is carried down from the nearest ancestor with metadata
             // (not empty when there is none).
-            bool invalid = false;
-            for (uint c = ci; c < n; ++c) {
+            cached_node = Dt.first_node + local;
+            stats.nodes = stats.nodes + 1u;
+            uint invalid = 0u;
+            for (uint c = uint(bitCount(state)); c < n; ++c) {
               if (((live >> c) & 1u) == 0u) {
                 cached_empty = cached_empty | (1u << c);
                 continue;
@@ -239,21 +302,20 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               ResoctSlotInfo sc = resoct_read_slot(bank + c);
               uint cls;
               RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                cls = resoct_mode_node_class(node, sc, f.node_slot_count, fx.proj[c]);
+                cls = resoct_mode_node_class(cached_node, sc, f.node_slot_count, fx.proj[c]);
               }
               else {
-                cls = resoct_node_class(node, sc, f.node_slot_count);
+                cls = resoct_node_class(cached_node, sc, f.node_slot_count);
               }
               if (cls == RESOCT_NODE_CLASS_INVALID) {
-                invalid = true;
+                invalid = invalid | (1u << c);
                 RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                  cls =
-                      resoct_mode_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
-                                                     trav_log2, sc, f.node_slot_count, fx.proj[c]);
+                  cls = resoct_mode_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
+                                                       f.node_slot_count, fx.proj[c]);
                 }
                 else {
-                  cls = resoct_node_class_carried(node, trav_depth, f.start_depth, trav_coord,
-                                                  trav_log2, sc, f.node_slot_count);
+                  cls = resoct_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
+                                                  f.node_slot_count);
                 }
                 // A homogeneous ancestor's value is only known at the ancestor: read it there.
                 if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
@@ -261,15 +323,23 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
               if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
             }
-            if (invalid && node != last_node_request) {
-              last_node_request = node;
-              resoct_report_node_request(node);
+            uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
+            if (cached_empty == all) {
+              cached_skip_depth = cap_depth;
+            } else if ((invalid >> uint(findLSB(~cached_empty))) != 0u &&
+                       cached_node != last_node_request) {
+              // Requested when an INVALID channel is at or after the first channel that is
+              // not empty here: channels before it were settled by their ancestors' records.
+              last_node_request = cached_node;
+              resoct_report_node_request(cached_node);
               stats.requests = stats.requests + 1u;
             }
-            uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
-            if (cached_empty == all) cached_skip_depth = trav_depth;
+          } else {
+            ResoctDepthInfo Dk = resoct_read_depth(cached_skip_depth);
+            cached_node = Dk.first_node + path_local[cached_skip_depth];
           }
         }
+        uint node = cached_node;
         if (cached_skip_depth != RESOCT_NONE_U) {
           ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
           uvec3 nc = resoct_node_coord(Ds, cell);
