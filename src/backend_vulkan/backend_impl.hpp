@@ -49,6 +49,7 @@ enum Binding : std::uint32_t {
   b_stats,
   b_cache1,  // cache chunks 1..7 (chunk 0 is b_cache)
   b_cache7 = b_cache1 + 6,
+  b_preint,  // pre-integration tables (binding 21)
   binding_count
 };
 

@@ -24,6 +24,7 @@
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/gradient.glsl.h"
 #include "resoct/kernel/isosurface.glsl.h"
+#include "resoct/kernel/preintegration.glsl.h"
 #include "resoct/kernel/projection.glsl.h"
 #include "resoct/kernel/shadow.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
@@ -126,9 +127,9 @@ RESOCT_FN bool resoct_fx_iso_hit(ResoctSampleParams sp, ResoctFxParams p, Resoct
 RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
                                     uint c, ResoctSlotInfo s, float value, uint level, uint lod,
                                     float seg, float tm, ivec3 cell, vec3 frac,
-                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(vec4) weighted,
-                                    RESOCT_INOUT(float) combined, RESOCT_INOUT(vec4) acc,
-                                    RESOCT_INOUT(ResoctRayStats) st) {
+                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(ResoctPreintRay) pr,
+                                    RESOCT_INOUT(vec4) weighted, RESOCT_INOUT(float) combined,
+                                    RESOCT_INOUT(vec4) acc, RESOCT_INOUT(ResoctRayStats) st) {
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     if (s.mode == RESOCT_CHANNEL_MIP) {
       fx.proj[c] = max(fx.proj[c], clamp(value, 0.0f, 1.0f));
@@ -153,9 +154,17 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
       surface = true;
     }
   }
-  vec4 rgba = resoct_tf_lookup(s.slot, pv);
-  // A surface keeps its TF alpha; a DVR sample's alpha is corrected for the segment.
-  float a = surface ? min(rgba.a, 1.0f) : resoct_correct_opacity(rgba.a, seg / p.ref_step);
+  // A surface keeps its TF alpha; a DVR sample's alpha is corrected for the segment (or comes
+  // from the pre-integrated segment, whose colour shading then multiplies like a point's).
+  vec4 rgba;
+  float a;
+  if (surface) {
+    rgba = resoct_tf_lookup(s.slot, pv);
+    a = min(rgba.a, 1.0f);
+  } else {
+    rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, pv, seg / p.ref_step);
+    a = rgba.a;
+  }
   vec3 rgb = vec3(rgba.r, rgba.g, rgba.b);
   bool lit = surface;
   RESOCT_IF_FX(RESOCT_EFFECT_SHADING) {
