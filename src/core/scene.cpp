@@ -537,7 +537,8 @@ std::string scene_to_json(const Scene& s) {
   json effects = json::array();
   for (Effect e : s.effects) effects.push_back(to_string(e));
   doc["effects"] = effects;
-  doc["preintegration"] = s.preintegration;
+  // Written only when on, so that documents of scenes without it are unchanged.
+  if (s.preintegration) doc["preintegration"] = true;
   detail::slices_and_lens_to_json(s, doc);
   effects_to_json(s, doc);
   return doc.dump(2) + "\n";

@@ -221,33 +221,84 @@ TEST(PreintSegment, OpaqueEntriesGiveFullOpacity) {
   EXPECT_NEAR(half.g, brute_segment(tf, 0.45, 0.95, 1.0).g, 2e-3);
 }
 
-TEST(PreintSegment, NanIsTransparentAndRestartsTheSegment) {
+TEST(PreintSegment, NanIsTransparent) {
   install(smooth_tf());
   const float nan = std::numeric_limits<float>::quiet_NaN();
   EXPECT_EQ(k::resoct_preint_segment(0, nan, 0.5f, 1.0f), glm::vec4(0.0f));
   EXPECT_EQ(k::resoct_preint_segment(0, 0.5f, nan, 1.0f), glm::vec4(0.0f));
   EXPECT_EQ(k::resoct_preint_segment(0, 0.5f, 0.5f, 0.0f), glm::vec4(0.0f));
+}
+
+// Opacity of a point of reference-step opacity from the table's knots, over `ratio` steps.
+double point_alpha(float v, double ratio) {
+  const glm::vec4 p = k::resoct_preint_average(0, v, v);
+  return -std::expm1(-ratio * double(p.a));
+}
+
+// Runs of one channel over a march of steps of 1 reference step: a run covers exactly its
+// steps (half-step points at both ends, segments between midpoints), and a NaN, a sample
+// without a value and a view LOD change end the run (its tail is composited first).
+TEST(PreintRun, RunsCoverExactlyTheirStepsAndEndAtNanGapsAndLevelChanges) {
+  install(smooth_tf());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
   k::ResoctPreintRay pr;
   k::resoct_preint_ray_clear(pr);
-  k::resoct_preint_begin_sample(pr, 0u);
-  (void)k::resoct_preint_sample(pr, 3u, 0u, 0.2f, 1.0f);
-  k::resoct_preint_end_sample(pr);
-  k::resoct_preint_begin_sample(pr, 0u);
-  EXPECT_EQ(k::resoct_preint_sample(pr, 3u, 0u, nan, 1.0f), glm::vec4(0.0f));
-  k::resoct_preint_end_sample(pr);
-  // After the NaN the next sample is a point, not a segment from 0.2.
-  k::resoct_preint_begin_sample(pr, 0u);
-  expect_near4(k::resoct_preint_sample(pr, 3u, 0u, 0.9f, 1.0f),
-               glm::dvec4(k::resoct_preint_segment(0, 0.9f, 0.9f, 1.0f)), 0.0, "restart");
-  k::resoct_preint_end_sample(pr);
-  // A continued segment, then a level change restarts it.
-  k::resoct_preint_begin_sample(pr, 0u);
-  expect_near4(k::resoct_preint_sample(pr, 3u, 0u, 0.1f, 1.0f),
-               glm::dvec4(k::resoct_preint_segment(0, 0.9f, 0.1f, 1.0f)), 0.0, "continued");
-  k::resoct_preint_end_sample(pr);
-  k::resoct_preint_begin_sample(pr, 1u);
-  expect_near4(k::resoct_preint_sample(pr, 3u, 0u, 0.6f, 1.0f),
-               glm::dvec4(k::resoct_preint_segment(0, 0.6f, 0.6f, 1.0f)), 0.0, "level change");
+  glm::vec4 acc(0.0f);
+  auto sample = [&](std::uint32_t lod, float v, bool has_value) {
+    acc = k::resoct_preint_begin_sample(pr, lod, 1.0f, acc);
+    glm::vec4 rgba(0.0f);
+    if (has_value) rgba = k::resoct_preint_sample(pr, 3u, 0u, v);
+    acc = k::resoct_preint_end_sample(pr, acc);
+    acc = k::resoct_composite(acc, k::resoct_premultiply(glm::vec3(rgba), rgba.a));
+    return rgba;
+  };
+  // Run 1: 0.2 (half-step point), 0.4 (segment 0.2 -> 0.4 over one step).
+  EXPECT_NEAR(sample(0, 0.2f, true).a, point_alpha(0.2f, 0.5), 1e-6);
+  EXPECT_NEAR(sample(0, 0.4f, true).a, k::resoct_preint_segment(0, 0.2f, 0.4f, 1.0f).a, 1e-6);
+  // NaN: transparent; the run's tail (0.4 over half a step) is composited before it.
+  const float before = acc.a;
+  EXPECT_EQ(sample(0, nan, true), glm::vec4(0.0f));
+  const double tail = point_alpha(0.4f, 0.5);
+  EXPECT_NEAR(acc.a, before + (1.0 - before) * tail, 1e-6);
+  // Run 2 starts from a point again, continues, then a sample without a value ends it.
+  EXPECT_NEAR(sample(0, 0.9f, true).a, point_alpha(0.9f, 0.5), 1e-6);
+  EXPECT_NEAR(sample(0, 0.1f, true).a, k::resoct_preint_segment(0, 0.9f, 0.1f, 1.0f).a, 1e-6);
+  float a0 = acc.a;
+  sample(0, 0.0f, false);
+  EXPECT_NEAR(acc.a, a0 + (1.0 - a0) * point_alpha(0.1f, 0.5), 1e-6);
+  // Run 3 at level 0, then a level change: tail of 0.6, and 0.7 starts a new run as a point.
+  sample(0, 0.6f, true);
+  a0 = acc.a;
+  const glm::vec4 after_change = sample(1, 0.7f, true);
+  EXPECT_NEAR(after_change.a, point_alpha(0.7f, 0.5), 1e-6);
+  const double with_tail = a0 + (1.0 - a0) * point_alpha(0.6f, 0.5);
+  EXPECT_NEAR(acc.a, with_tail + (1.0 - with_tail) * after_change.a, 1e-6);
+  // The end of the ray flushes the open run: 0.7 over half a step.
+  a0 = acc.a;
+  acc = k::resoct_preint_flush(pr, acc);
+  EXPECT_NEAR(acc.a, a0 + (1.0 - a0) * point_alpha(0.7f, 0.5), 1e-6);
+  EXPECT_EQ(k::resoct_preint_flush(pr, acc), acc);
+}
+
+// A constant value over a whole run gives the same total opacity as point sampling the same
+// steps with opacity correction: the run integrates exactly the steps it sampled.
+TEST(PreintRun, ConstantRunEqualsPointSamplingOfTheSameSteps) {
+  install(smooth_tf());
+  const float v = 0.6f;
+  k::ResoctPreintRay pr;
+  k::resoct_preint_ray_clear(pr);
+  glm::vec4 pre(0.0f), point(0.0f);
+  const float steps[] = {1.0f, 1.0f, 0.5f, 1.0f, 0.3f};
+  for (float st : steps) {
+    pre = k::resoct_preint_begin_sample(pr, 0u, st, pre);
+    const glm::vec4 s = k::resoct_preint_sample(pr, 0u, 0u, v);
+    pre = k::resoct_preint_end_sample(pr, pre);
+    pre = k::resoct_composite(pre, k::resoct_premultiply(glm::vec3(s), s.a));
+    const glm::vec4 p = k::resoct_preint_segment(0, v, v, st);
+    point = k::resoct_composite(point, k::resoct_premultiply(glm::vec3(p), p.a));
+  }
+  pre = k::resoct_preint_flush(pr, pre);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(pre[c], point[c], 2e-6) << c;
 }
 
 TEST(PreintSegment, ValuesOutsideTheRangeTakeTheEndEntries) {

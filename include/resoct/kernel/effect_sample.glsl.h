@@ -174,6 +174,9 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
     rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, pl, lod, pc, pf, pv, rgb,
                                      surface || a > RESOCT_SHADOW_MIN_ALPHA, st);
   }
+  RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+    if (!surface) resoct_preint_set_tail_colour(pr, c, rgb);
+  }
   if (surface) {
     acc = resoct_composite(acc, resoct_premultiply(rgb, a));
   } else {

@@ -26,12 +26,13 @@
 // point-sampled, opacity-corrected lookup (tf.glsl.h + resoct_correct_opacity) up to float
 // rounding, between knots it differs by the convexity of −ln(1 − α) within one LUT bin.
 //
-// Per-ray state (ResoctPreintRay): the previous value of each channel. A channel's segment
-// restarts from the current sample (s_f = s_b) when it had no value at the previous sample (first
-// sample, a skipped node or brick, a missing brick, NaN), after a slice/lens segment boundary and
-// when the view LOD level changes (values of different levels are not one linear function).
-// A coarser level substituted for a missing finer brick in residency mode is not detected: the
-// point path mixes the levels in the same way.
+// Runs (ResoctPreintRay): a channel's consecutive values form a run, integrated segment by
+// segment between sample midpoints, with half-step points at both ends so that a run covers
+// exactly the steps it sampled. A run ends (and the next value starts a new one) when the channel
+// has no value at a sample (a skipped node or brick, an empty node for that channel, a missing
+// brick, NaN), at a slice/lens segment boundary and when the view LOD level changes (values of
+// different levels are not one linear function). A coarser level substituted for a missing finer
+// brick in residency mode is not detected: the point path mixes the levels in the same way.
 //
 // Accessor the including file must define BEFORE including this header:
 //   vec4 resoct_read_preint(uint slot, uint index)   // index < 2 * RESOCT_TF_LUT_SIZE
@@ -135,52 +136,110 @@ RESOCT_FN vec4 resoct_preint_segment(uint slot, float sf, float sb, float step_r
   return vec4(rgb, alpha);
 }
 
-/// Per-ray state: each channel's previous value (valid where `have` has its bit), the channels
-/// that got a value at the current sample (`got`) and the view LOD level of the previous sample.
+/// Per-ray state. Samples sit at the midpoints m_i of the march's steps [t_i, t_i + Δ_i]; a
+/// channel's run of consecutive values is integrated as
+///   [t_first, m_first]        the first value as a point (half a step)
+///   [m_{i−1}, m_i]            pre-integrated segments between consecutive values
+///   [m_last, t_last + Δ_last] the last value as a point (the "tail", composited when the run
+///                             ends: at the next sample without a value, at a view LOD change,
+///                             at a slice/lens boundary or at the end of the ray)
+/// so each run covers exactly the steps it sampled, like the point-sampled march, and nothing
+/// is counted twice. `prev` holds the last values, `tail` the tails' straight colour (that of
+/// the run's last segment, lit in effect specializations, so that shading treats a tail like the
+/// sample it continues) and extinction per reference step at the last value, `have` the open runs,
+/// `got` the channels with a value at the current sample; `half` and `prev_half` are half the
+/// current and previous step in reference steps.
 struct ResoctPreintRay {
   float prev[RESOCT_MAX_SLOTS];
+  vec4 tail[RESOCT_MAX_SLOTS];
   uint have;
   uint got;
   uint lod;
+  float half_step;
+  float prev_half_step;
 };
 
 RESOCT_FN void resoct_preint_ray_clear(RESOCT_OUT(ResoctPreintRay) pr) {
-  for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) pr.prev[i] = 0.0f;
+  for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) {
+    pr.prev[i] = 0.0f;
+    pr.tail[i] = vec4(0.0f);
+  }
   pr.have = 0u;
   pr.got = 0u;
   pr.lod = 0xFFFFFFFFu;
+  pr.half_step = 0.0f;
+  pr.prev_half_step = 0.0f;
 }
 
-/// Starts a sample at view LOD level `lod`: a level change restarts every channel's segment.
-RESOCT_FN void resoct_preint_begin_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint lod) {
-  if (lod != pr.lod) pr.have = 0u;
-  pr.lod = lod;
-  pr.got = 0u;
-}
-
-/// Channel c's value `value` at the current sample: the segment from its previous value (or a
-/// point when there is none) and records the value for the next segment.
+/// Channel c's value at the current sample: straight colour and opacity of the pre-integrated
+/// segment from its previous value, or of the half-step point that starts a run. NaN is
+/// transparent and ends the run.
 RESOCT_FN vec4 resoct_preint_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint c, uint slot,
-                                    float value, float step_ratio) {
-  bool have = ((pr.have >> c) & 1u) != 0u;
-  float sf = have ? pr.prev[c] : value;
-  if (!isnan(value)) {
-    pr.prev[c] = value;
-    pr.got = pr.got | (1u << c);
-  }
-  return resoct_preint_segment(slot, sf, value, step_ratio);
+                                    float value) {
+  if (isnan(value)) return vec4(0.0f);
+  bool cont = ((pr.have >> c) & 1u) != 0u;
+  float sf = cont ? pr.prev[c] : value;
+  float ratio = cont ? pr.prev_half_step + pr.half_step : pr.half_step;
+  pr.prev[c] = value;
+  pr.got = pr.got | (1u << c);
+  vec4 seg = resoct_preint_segment(slot, sf, value, ratio);
+  pr.tail[c] = vec4(seg.r, seg.g, seg.b, resoct_preint_average(slot, value, value).a);
+  return seg;
 }
 
-/// Ends a sample: only channels with a value here continue their segment at the next sample
-/// (a skip, an empty node or a missing brick restarts it).
-RESOCT_FN void resoct_preint_end_sample(RESOCT_INOUT(ResoctPreintRay) pr) {
+/// Sets the colour the tail of channel c's run will have (effects: the lit colour).
+RESOCT_FN void resoct_preint_set_tail_colour(RESOCT_INOUT(ResoctPreintRay) pr, uint c, vec3 rgb) {
+  pr.tail[c] = vec4(rgb, pr.tail[c].a);
+}
+
+/// Composites the tails of the runs in `ending` (intermixed like one sample) onto `acc`.
+RESOCT_FN vec4 resoct_preint_composite_tails(RESOCT_INOUT(ResoctPreintRay) pr, uint ending,
+                                             vec4 acc) {
+  if (ending == 0u) return acc;
+  vec4 weighted;
+  float combined;
+  resoct_mix_begin(weighted, combined);
+  float ratio = pr.prev_half_step;
+  for (uint c = 0u; c < RESOCT_MAX_SLOTS; ++c) {
+    if (((ending >> c) & 1u) == 0u) continue;
+    vec4 t = pr.tail[c];
+    float a =
+        t.a >= RESOCT_PREINT_TAU_MAX ? 1.0f : clamp(resoct_one_minus_exp(-ratio * t.a), 0.0f, 1.0f);
+    resoct_mix_add(weighted, combined, vec3(t.r, t.g, t.b), a);
+  }
+  return resoct_composite(acc, resoct_mix_result(weighted, combined));
+}
+
+/// Ends a sample, before its own mix is composited: the runs that did not continue here get
+/// their tails composited onto `acc` (they lie before this sample's steps); the channels with a
+/// value here carry on.
+RESOCT_FN vec4 resoct_preint_end_sample(RESOCT_INOUT(ResoctPreintRay) pr, vec4 acc) {
+  uint ending = pr.have & ~pr.got;
+  vec4 out_acc = resoct_preint_composite_tails(pr, ending, acc);
   pr.have = pr.got;
   pr.got = 0u;
+  pr.prev_half_step = pr.half_step;
+  return out_acc;
 }
 
-/// A slice/lens segment boundary: every channel restarts.
-RESOCT_FN void resoct_preint_restart(RESOCT_INOUT(ResoctPreintRay) pr) {
+/// The end of the ray or of a slice/lens segment: every open run's tail.
+RESOCT_FN vec4 resoct_preint_flush(RESOCT_INOUT(ResoctPreintRay) pr, vec4 acc) {
+  vec4 out_acc = resoct_preint_composite_tails(pr, pr.have, acc);
   pr.have = 0u;
+  return out_acc;
+}
+
+/// Starts a sample at view LOD level `lod` whose step is `step_ratio` reference steps. A level
+/// change ends every run (values of different levels are not one linear function): their tails
+/// are composited onto `acc` here, before anything of this sample.
+RESOCT_FN vec4 resoct_preint_begin_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint lod,
+                                          float step_ratio, vec4 acc) {
+  vec4 out_acc = acc;
+  if (lod != pr.lod) out_acc = resoct_preint_flush(pr, acc);
+  pr.lod = lod;
+  pr.got = 0u;
+  pr.half_step = 0.5f * step_ratio;
+  return out_acc;
 }
 
 /// Straight colour and corrected opacity of a DVR channel's value at a sample of `step_ratio`
@@ -188,7 +247,7 @@ RESOCT_FN void resoct_preint_restart(RESOCT_INOUT(ResoctPreintRay) pr) {
 RESOCT_FX_FN vec4 resoct_dvr_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint c, uint slot,
                                     float value, float step_ratio) {
   RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-    return resoct_preint_sample(pr, c, slot, value, step_ratio);
+    return resoct_preint_sample(pr, c, slot, value);
   }
   vec4 rgba = resoct_tf_lookup(slot, value);
   return vec4(rgba.r, rgba.g, rgba.b, resoct_correct_opacity(rgba.a, step_ratio));

@@ -172,7 +172,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                                             resoct_view_depth(f, dir_box, tm), f.lod_error_px);
       uint lod = resoct_lod_level(budget, f.level_count);
       RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-        resoct_preint_begin_sample(pr, lod);
+        acc = resoct_preint_begin_sample(pr, lod, seg / f.ref_step, acc);
       }
 
       vec4 weighted;
@@ -372,7 +372,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         }
       }
       RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-        resoct_preint_end_sample(pr);
+        acc = resoct_preint_end_sample(pr, acc);
       }
 
       if (any_value) {
@@ -396,13 +396,13 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         t = resoct_advance_t(t, seg);
       }
     }
+    RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+      if (!stop) acc = resoct_preint_flush(pr, acc);
+    }
     if (stop || segs.enabled == 0u ||
         !resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc, live,
                                 bank, cached_node, cached_coord, stats)) {
       break;
-    }
-    RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-      resoct_preint_restart(pr);
     }
   }
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
