@@ -136,6 +136,11 @@ RESOCT_FN vec4 resoct_preint_segment(uint slot, float sf, float sb, float step_r
   return vec4(rgb, alpha);
 }
 
+/// A tail's colour (8 bits per component) and slot (< 256) in one word.
+RESOCT_FN uint resoct_preint_pack_tail(vec3 rgb, uint slot) {
+  return (packUnorm4x8(vec4(rgb, 0.0f)) & 0x00FFFFFFu) | (slot << 24u);
+}
+
 /// Per-ray state. Samples sit at the midpoints m_i of the march's steps [t_i, t_i + Δ_i]; a
 /// channel's run of consecutive values is integrated as
 ///   [t_first, m_first]        the first value as a point (half a step)
@@ -144,14 +149,17 @@ RESOCT_FN vec4 resoct_preint_segment(uint slot, float sf, float sb, float step_r
 ///                             ends: at the next sample without a value, at a view LOD change,
 ///                             at a slice/lens boundary or at the end of the ray)
 /// so each run covers exactly the steps it sampled, like the point-sampled march, and nothing
-/// is counted twice. `prev` holds the last values, `tail` the tails' straight colour (that of
-/// the run's last segment, lit in effect specializations, so that shading treats a tail like the
-/// sample it continues) and extinction per reference step at the last value, `have` the open runs,
+/// is counted twice. `prev` holds the last values; `tail` the tails' straight colour (that of the
+/// run's last segment, lit in effect specializations, so that shading treats a tail like the
+/// sample it continues) at 8 bits per component and the channel's slot in the fourth byte (the
+/// tail's extinction is that of the last value, looked up when the run ends). Keeping the state at
+/// two words per slot matters on the GPU: the struct is passed in and out of the inlined helpers,
+/// and a larger one made lavapipe's effect pipelines miss the frame timeout; `have` the open runs,
 /// `got` the channels with a value at the current sample; `half` and `prev_half` are half the
 /// current and previous step in reference steps.
 struct ResoctPreintRay {
   float prev[RESOCT_MAX_SLOTS];
-  vec4 tail[RESOCT_MAX_SLOTS];
+  uint tail[RESOCT_MAX_SLOTS];
   uint have;
   uint got;
   uint lod;
@@ -162,7 +170,7 @@ struct ResoctPreintRay {
 RESOCT_FN void resoct_preint_ray_clear(RESOCT_OUT(ResoctPreintRay) pr) {
   for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) {
     pr.prev[i] = 0.0f;
-    pr.tail[i] = vec4(0.0f);
+    pr.tail[i] = 0u;
   }
   pr.have = 0u;
   pr.got = 0u;
@@ -183,13 +191,13 @@ RESOCT_FN vec4 resoct_preint_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint c, ui
   pr.prev[c] = value;
   pr.got = pr.got | (1u << c);
   vec4 seg = resoct_preint_segment(slot, sf, value, ratio);
-  pr.tail[c] = vec4(seg.r, seg.g, seg.b, resoct_preint_average(slot, value, value).a);
+  pr.tail[c] = resoct_preint_pack_tail(vec3(seg.r, seg.g, seg.b), slot);
   return seg;
 }
 
 /// Sets the colour the tail of channel c's run will have (effects: the lit colour).
 RESOCT_FN void resoct_preint_set_tail_colour(RESOCT_INOUT(ResoctPreintRay) pr, uint c, vec3 rgb) {
-  pr.tail[c] = vec4(rgb, pr.tail[c].a);
+  pr.tail[c] = resoct_preint_pack_tail(rgb, pr.tail[c] >> 24u);
 }
 
 /// Composites the tails of the runs in `ending` (intermixed like one sample) onto `acc`.
@@ -200,11 +208,15 @@ RESOCT_FN vec4 resoct_preint_composite_tails(RESOCT_INOUT(ResoctPreintRay) pr, u
   float combined;
   resoct_mix_begin(weighted, combined);
   float ratio = pr.prev_half_step;
-  for (uint c = 0u; c < RESOCT_MAX_SLOTS; ++c) {
-    if (((ending >> c) & 1u) == 0u) continue;
-    vec4 t = pr.tail[c];
+  // One pass per ending run, not per slot: lavapipe counts every loop back-edge against its
+  // per-invocation guard (docs/vulkan-backend.md).
+  for (uint e = ending; e != 0u; e = e & (e - 1u)) {
+    uint c = uint(findLSB(e));
+    vec4 t = unpackUnorm4x8(pr.tail[c]);
+    float v = pr.prev[c];
+    float tau = resoct_preint_average(pr.tail[c] >> 24u, v, v).a;
     float a =
-        t.a >= RESOCT_PREINT_TAU_MAX ? 1.0f : clamp(resoct_one_minus_exp(-ratio * t.a), 0.0f, 1.0f);
+        tau >= RESOCT_PREINT_TAU_MAX ? 1.0f : clamp(resoct_one_minus_exp(-ratio * tau), 0.0f, 1.0f);
     resoct_mix_add(weighted, combined, vec3(t.r, t.g, t.b), a);
   }
   return resoct_composite(acc, resoct_mix_result(weighted, combined));
@@ -235,7 +247,7 @@ RESOCT_FN vec4 resoct_preint_flush(RESOCT_INOUT(ResoctPreintRay) pr, vec4 acc) {
 RESOCT_FN vec4 resoct_preint_begin_sample(RESOCT_INOUT(ResoctPreintRay) pr, uint lod,
                                           float step_ratio, vec4 acc) {
   vec4 out_acc = acc;
-  if (lod != pr.lod) out_acc = resoct_preint_flush(pr, acc);
+  if (lod != pr.lod && pr.have != 0u) out_acc = resoct_preint_flush(pr, acc);
   pr.lod = lod;
   pr.got = 0u;
   pr.half_step = 0.5f * step_ratio;
