@@ -3,8 +3,8 @@
 // RESOCT_EFFECTS is not 0; the plain kernel never reaches this code.
 //
 //   dvr   TF colour and corrected opacity (pre-integrated over the segment from the channel's
-//         previous value with RESOCT_EFFECT_PREINT); with "shading" the colour is Blinn-Phong lit with the
-//         gradient normal, with "shadows" the diffuse and specular terms are scaled by the
+//         previous value with RESOCT_EFFECT_PREINT); with "shading" the colour is Blinn-Phong lit
+//         with the gradient normal, with "shadows" the diffuse and specular terms are scaled by the
 //         transmittance of a shadow ray (samples above RESOCT_SHADOW_MIN_ALPHA only).
 //   iso   a crossing of an isovalue between the channel's previous and current sample is refined
 //         on the trilinear cells (isosurface.glsl.h); the surface is composited at the hit,
