@@ -7,7 +7,8 @@
 //
 //   BM_Accuracy/dataset:<d>/sweep:<s>/value:<v>
 //     d = 0 tubes (1 channel), 1 turbulence (1 channel), 2 cells (4 of 16 channels)
-//     s = 0 grid: step scale {0.25, 0.5, 1, 2, 4} × LOD error {0.5, 1, 2, 4, 8} px, v = 5i + j
+//     s = 0 grid: step scale {0.25, 0.5, 1, 2, 4} × LOD error {0.5, 1, 2, 4, 8} px ×
+//         pre-integration {off, on}, no early termination (ERT opacity 1.0), v = 10i + 2j + p
 //         1 level ranges: v = L in 0..2 forces every channel to levels >= L; v = 3 gives channel
 //           k the range k % 3 .. 15 (per-channel ranges)
 //         2 octree leaf size: v = 0 32³, 1 16³, 2 8³ (step 1, LOD 1 px)
@@ -15,11 +16,16 @@
 //           (v odd), level 0 only. "Off" scales the frame's reference step by the step scale,
 //           so transfer-function alpha is applied per step as is (a renderer that ignores
 //           the step length); the reference is always corrected.
-//         4 early termination opacity {0.95, 0.99, 1.0} (step 1, LOD 1 px)
+//         4 early termination opacity {0.99, 0.995, 0.999} × step scale {0.25 .. 4} ×
+//           pre-integration {off, on} at LOD 0.5 px, v = 6i + 2e + p (ERT 1.0 rows: grid)
+// Every other sweep: pre-integration off, the scene's ERT 0.99. The finest setting, the base of
+// the speed-ups report.py prints, is the grid row step 0.25, LOD 0.5 px, ERT 1.0, pre-integration
+// off: the most accurate point-sampling configuration, like the reference without termination.
 // Counters: ms_frame, rmse (RGB, over the image, values in [0, 1]), psnr_db, max_err (largest
-// absolute RGB difference), step_scale, lod_px, plus the working set and per-ray counters of
-// bench_table1. bench/scripts/report.py extracts the Pareto front (rmse vs ms) per dataset.
-// Sizes: 128³ / 256×256×40 with 128² images (standard), 256³ / 512×512×40 with 256² images
+// absolute RGB difference), step_scale, lod_px, preint (0/1), ert (termination opacity), plus the
+// working set and per-ray counters of bench_table1. bench/scripts/report.py extracts the Pareto
+// front (rmse vs ms) per dataset. Sizes: 128³ / 256×256×40 with 128² images (standard), 256³ /
+// 512×512×40 with 256² images
 // (--large or RESOCT_BENCH_LARGE=1), 24³ / 64×64×40 with 24² images (--smoke or
 // RESOCT_BENCH_SMOKE=1).
 #include <algorithm>
@@ -42,7 +48,7 @@ constexpr const char* kNames[] = {"tubes", "turbulence", "cells"};
 constexpr double kSteps[] = {0.25, 0.5, 1.0, 2.0, 4.0};
 constexpr double kLods[] = {0.5, 1.0, 2.0, 4.0, 8.0};
 const glm::uvec3 kLeaves[] = {glm::uvec3(32), glm::uvec3(16), glm::uvec3(8)};
-constexpr double kErts[] = {0.95, 0.99, 1.0};
+constexpr double kErts[] = {0.99, 0.995, 0.999};
 
 std::string spec_for(int dataset) {
   const Preset p = preset();
@@ -132,9 +138,11 @@ void BM_Accuracy(benchmark::State& state) {
   std::string label = kNames[dataset];
   switch (sweep) {
     case 0:
-      scene.step_scale = kSteps[value / 5];
-      scene.lod_error_px = kLods[value % 5];
-      label += "/grid";
+      scene.step_scale = kSteps[value / 10];
+      scene.lod_error_px = kLods[(value / 2) % 5];
+      scene.preintegration = value % 2 == 1;
+      scene.ert_opacity = 1.0;
+      label += scene.preintegration ? "/grid preint" : "/grid";
       break;
     case 1:
       for (std::size_t k = 0; k < scene.channels.size(); ++k) {
@@ -150,8 +158,12 @@ void BM_Accuracy(benchmark::State& state) {
       label += uncorrected ? "/opacity-correction off" : "/opacity-correction on";
       break;
     default:
-      scene.ert_opacity = kErts[value];
-      label += "/ert " + std::to_string(kErts[value]).substr(0, 4);
+      scene.step_scale = kSteps[value / 6];
+      scene.lod_error_px = 0.5;
+      scene.ert_opacity = kErts[(value / 2) % 3];
+      scene.preintegration = value % 2 == 1;
+      label += "/ert " + std::to_string(kErts[(value / 2) % 3]).substr(0, 5) +
+               (scene.preintegration ? " preint" : "");
       break;
   }
   FrameOptions o;
@@ -167,12 +179,14 @@ void BM_Accuracy(benchmark::State& state) {
   state.counters["max_err"] = std::max({diff.max_abs[0], diff.max_abs[1], diff.max_abs[2]});
   state.counters["step_scale"] = scene.step_scale;
   state.counters["lod_px"] = scene.lod_error_px;
+  state.counters["preint"] = scene.preintegration ? 1.0 : 0.0;
+  state.counters["ert"] = scene.ert_opacity;
   state.SetLabel(label);
 }
 
 BENCHMARK(BM_Accuracy)
     ->Apply([](benchmark::internal::Benchmark* b) {
-      const int counts[] = {25, 4, 3, 6, 3};
+      const int counts[] = {50, 4, 3, 6, 30};
       for (int dataset = 0; dataset < 3; ++dataset) {
         for (int sweep = 0; sweep < 5; ++sweep) {
           for (int v = 0; v < counts[sweep]; ++v) b->Args({dataset, sweep, v});

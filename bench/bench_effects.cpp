@@ -15,6 +15,8 @@
 //         9 MIP (every channel), 10 AIP (every channel)
 //         11 combined: channel 0 iso, shading and shadows (factor 2) on the rest, and on
 //            cells channel 2 as MIP
+//         12 pre-integrated transfer functions alone (kernel/preintegration.glsl.h)
+//         13 shading with pre-integration
 // Counters: ms_frame, ratio (ms_frame / plain's), gradient_evals_per_ray, shadow_rays_per_ray,
 // and image errors: rmse_vs_central (forward vs central differences), shadow_rmse (shadows at
 // factor 2 / 4 against factor 1, RGB RMSE over the image).
@@ -49,8 +51,10 @@ constexpr const char* kConfigs[] = {"plain",
                                     "iso+shadows x2",
                                     "mip",
                                     "aip",
-                                    "combined"};
-constexpr int kConfigCount = 12;
+                                    "combined",
+                                    "preintegration",
+                                    "shading central + preintegration"};
+constexpr int kConfigCount = 14;
 
 std::string spec_for(int dataset) {
   const Preset p = preset();
@@ -120,6 +124,11 @@ Scene config_scene(const Rig& rig, int dataset, int config) {
       s.channels[0].isovalues = {0.35};
       if (s.channels.size() > 2) s.channels[2].mode = ChannelMode::mip;
       shadows(2);
+      break;
+    case 12: s.preintegration = true; break;
+    case 13:
+      s.effects = {Effect::shading};
+      s.preintegration = true;
       break;
     default: break;
   }

@@ -86,6 +86,9 @@ struct FrameTables {
   std::vector<kernel::ResoctLevelInfo> levels;  ///< one per hierarchy level
   std::vector<kernel::ResoctDepthInfo> depths;  ///< one per octree depth
   std::vector<glm::vec4> tf_luts;  ///< page_slot_count * RESOCT_TF_LUT_SIZE, indexed by slot
+  /// With RESOCT_EFFECT_PREINT in fx.effects: page_slot_count * 2 * RESOCT_TF_LUT_SIZE entries,
+  /// indexed by slot (preintegration_table(), kernel/preintegration.glsl.h); else empty.
+  std::vector<glm::vec4> preint_tables;
 };
 
 /// Per-frame statistics a backend reports (sums over rays).

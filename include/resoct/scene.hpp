@@ -83,6 +83,8 @@ struct Scene {
   double ert_opacity = 0.99;  ///< early termination opacity, in (0, 1]
   glm::dvec4 background{0.0, 0.0, 0.0, 1.0};  ///< straight-alpha RGBA, each in [0, 1]
   std::vector<Effect> effects;
+  /// Pre-integrated transfer functions for DVR channels (docs/rendering.md "Pre-integration").
+  bool preintegration = false;
   // Slices and lens (docs/scene.md "Slices and lens").
   std::vector<SlicePlane> slices;  ///< at most kMaxSlices planes
   std::optional<Lens> lens;        ///< none: every channel everywhere

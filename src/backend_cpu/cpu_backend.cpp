@@ -171,6 +171,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.levels = tables.levels.data();
   c.depths = tables.depths.data();
   c.tf = tables.tf_luts.data();
+  c.preint = tables.preint_tables.data();
   c.fx = &tables.fx;
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;
@@ -186,9 +187,14 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   glm::vec4* pixels = result.image.pixels().data();
   const int threads = threads_ > 0 ? threads_ : omp_get_max_threads();
   // The effect mask picks the kernel specialization once per frame.
-  const std::uint32_t mask = tables.fx.effects & kernel::RESOCT_EFFECT_ANY;
-  const detail::RayTotals r = mask == 0u ? detail::render_plain(frame, pixels, threads)
-                                         : detail::render_effects(mask, frame, pixels, threads);
+  const std::uint32_t mask = tables.fx.effects & (kernel::RESOCT_EFFECT_MASKS - 1u);
+  const std::uint32_t fx = mask & kernel::RESOCT_EFFECT_ANY;
+  const bool preint = (mask & kernel::RESOCT_EFFECT_PREINT) != 0u;
+  const detail::RayTotals r =
+      fx == 0u ? (preint ? detail::render_preint(frame, pixels, threads)
+                         : detail::render_plain(frame, pixels, threads))
+               : (preint ? detail::render_effects_preint(fx, frame, pixels, threads)
+                         : detail::render_effects(fx, frame, pixels, threads));
 
   BackendStats& s = result.stats;
   s = BackendStats{};

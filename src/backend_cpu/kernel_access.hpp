@@ -3,7 +3,9 @@
 // CpuBackend::render under a mutex) and the tile loop of one frame, specialized per effect mask.
 // The mask-0 (plain) instantiation and the effect instantiations live in separate translation
 // units (render_plain.cpp, render_effects.cpp) so that the compiler's unit-wide inlining budget
-// spent on sixteen kernel copies cannot change how the plain kernel is optimized.
+// spent on sixteen kernel copies cannot change how the plain kernel is optimized. The same
+// split holds with pre-integration (render_preint.cpp, render_effects_preint.cpp), which also
+// keeps each unit's compile time and memory those of sixteen copies.
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
@@ -31,6 +33,7 @@ struct KernelContext {
   const kernel::ResoctLevelInfo* levels = nullptr;
   const kernel::ResoctDepthInfo* depths = nullptr;
   const glm::vec4* tf = nullptr;
+  const glm::vec4* preint = nullptr;  // pre-integration tables (empty frame: unused)
   const kernel::ResoctFxFrame* fx = nullptr;
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
@@ -118,6 +121,9 @@ inline ResoctDepthInfo resoct_read_depth(uint d) {
 inline vec4 resoct_read_tf(uint slot, uint index) {
   return cpu::detail::g_ctx.tf[std::size_t(slot) * 1024u + index];
 }
+inline vec4 resoct_read_preint(uint slot, uint index) {
+  return cpu::detail::g_ctx.preint[std::size_t(slot) * 2048u + index];
+}
 inline ResoctFxFrame resoct_read_fx_frame() {
   return *cpu::detail::g_ctx.fx;
 }
@@ -168,10 +174,12 @@ struct RayTotals {
 // lens), each time costing instructions per sample on the path of scenes that use none of
 // them; flattening makes the plain path's code independent of those features. Only mask 0 is
 // flattened: the effect kernels' shadow and gradient marches would multiply in size.
+// Pre-integration alone (RESOCT_EFFECT_PREINT) is a plain path too and is flattened likewise.
+template <std::uint32_t EFFECTS>
 [[gnu::flatten]] inline glm::vec4 resoct_render_pixel_plain(const kernel::ResoctFrame& frame,
                                                             std::uint32_t x, std::uint32_t y,
                                                             kernel::ResoctRayStats& st) {
-  return kernel::resoct_render_pixel_fx<0u>(frame, x, y, st);
+  return kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
 }
 
 // All tiles of one frame with the kernel specialized for the effect mask EFFECTS: the mask is
@@ -198,8 +206,8 @@ RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int 
       for (std::uint32_t x = tx; x < x1; ++x) {
         kernel::ResoctRayStats st{};
         glm::vec4 p;
-        if constexpr (EFFECTS == 0u) {
-          p = resoct_render_pixel_plain(frame, x, y, st);
+        if constexpr ((EFFECTS & kernel::RESOCT_EFFECT_ANY) == 0u) {
+          p = resoct_render_pixel_plain<EFFECTS>(frame, x, y, st);
         } else {
           p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
         }
@@ -227,8 +235,14 @@ RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int 
 
 /// The plain kernel (render_plain.cpp).
 RayTotals render_plain(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
-/// The kernel specialized for `mask` (1 .. RESOCT_EFFECT_MASKS - 1; render_effects.cpp).
+/// The plain kernel with pre-integration, mask RESOCT_EFFECT_PREINT (render_preint.cpp).
+RayTotals render_preint(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
+/// The kernel specialized for `mask` (1 .. 15; render_effects.cpp).
 RayTotals render_effects(std::uint32_t mask, const kernel::ResoctFrame& frame, glm::vec4* pixels,
                          int threads);
+/// The kernel specialized for `mask` (17 .. 31: effects with pre-integration;
+/// render_effects_preint.cpp).
+RayTotals render_effects_preint(std::uint32_t mask, const kernel::ResoctFrame& frame,
+                                glm::vec4* pixels, int threads);
 
 }  // namespace resoct::cpu::detail

@@ -16,14 +16,15 @@ constexpr std::array<TileRenderer, sizeof...(Masks)> make_renderers(
   return {&render_tiles<Masks>...};
 }
 
+// Masks 0 .. 15 (0 is never chosen here: render_plain.cpp).
 constexpr auto kRenderers =
-    make_renderers(std::make_integer_sequence<std::uint32_t, kernel::RESOCT_EFFECT_MASKS>());
+    make_renderers(std::make_integer_sequence<std::uint32_t, kernel::RESOCT_EFFECT_PREINT>());
 
 }  // namespace
 
 RayTotals render_effects(std::uint32_t mask, const kernel::ResoctFrame& frame, glm::vec4* pixels,
                          int threads) {
-  return kRenderers[mask % kernel::RESOCT_EFFECT_MASKS](frame, pixels, threads);
+  return kRenderers[mask % kernel::RESOCT_EFFECT_PREINT](frame, pixels, threads);
 }
 
 }  // namespace resoct::cpu::detail

@@ -49,7 +49,8 @@ enum Binding : std::uint32_t {
   b_stats,
   b_cache1,  // cache chunks 1..7 (chunk 0 is b_cache)
   b_cache7 = b_cache1 + 6,
-  b_directory,  // the page directory
+  b_directory,  // the page directory (binding 21)
+  b_preint,     // pre-integration tables (binding 22)
   binding_count
 };
 

@@ -160,6 +160,8 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   ensure(b_depths, tables.depths.size() * sizeof(kernel::ResoctDepthInfo), "depth table");
   ensure(b_tf, std::max<std::size_t>(tables.tf_luts.size(), 1) * sizeof(glm::vec4),
          "transfer functions");
+  ensure(b_preint, std::max<std::size_t>(tables.preint_tables.size(), 1) * sizeof(glm::vec4),
+         "pre-integration tables");
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   begin_batch();
   // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
@@ -169,6 +171,9 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   stage_copy(buf[b_levels].buffer, 0, std::as_bytes(std::span(tables.levels)));
   stage_copy(buf[b_depths].buffer, 0, std::as_bytes(std::span(tables.depths)));
   stage_copy(buf[b_tf].buffer, 0, std::as_bytes(std::span(tables.tf_luts)));
+  if (!tables.preint_tables.empty()) {
+    stage_copy(buf[b_preint].buffer, 0, std::as_bytes(std::span(tables.preint_tables)));
+  }
 }
 
 }  // namespace resoct::vk

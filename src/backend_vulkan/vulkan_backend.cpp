@@ -196,7 +196,7 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& tables) con
   v.cache_chunks = chunks;
   v.workgroup_x = kWorkgroup;
   v.workgroup_y = kWorkgroup;
-  v.effects = tables.fx.effects & kernel::RESOCT_EFFECT_ANY;
+  v.effects = tables.fx.effects & (kernel::RESOCT_EFFECT_MASKS - 1u);
   return v;
 }
 

@@ -3,6 +3,7 @@
 #include "resoct/backend.hpp"
 #include "resoct/error.hpp"
 #include "resoct/transfer_function.hpp"
+#include "resoct/kernel/effects.glsl.h"
 
 namespace resoct {
 
@@ -27,6 +28,10 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
   }
   if (t.tf_luts.size() != std::size_t(f.page_slot_count) * kTfLutSize) {
     fail("tf_luts size differs from page_slot_count * RESOCT_TF_LUT_SIZE");
+  }
+  if ((t.fx.effects & kernel::RESOCT_EFFECT_PREINT) != 0u &&
+      t.preint_tables.size() != std::size_t(f.page_slot_count) * 2u * kTfLutSize) {
+    fail("preint_tables size differs from page_slot_count * 2 * RESOCT_TF_LUT_SIZE");
   }
   if (std::size_t(t.depths.back().first_node) * f.node_slot_count * 4u >= config.node_words + 1u &&
       config.node_words != 0) {

@@ -13,6 +13,7 @@
 #include "resoct/error.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/preintegration.hpp"
 #include "resoct/residency_octree.hpp"
 #include "frame_tables_slices.hpp"
 
@@ -88,6 +89,7 @@ std::uint32_t effect_mask(const Scene& scene) {
       m |= kernel::RESOCT_EFFECT_PROJECTION;
     }
   }
+  if (scene.preintegration) m |= kernel::RESOCT_EFFECT_PREINT;
   return m;
 }
 
@@ -250,6 +252,10 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
 
   out.slots.clear();
   out.tf_luts.assign(std::size_t(channels.slot_count()) * kTfLutSize, glm::vec4(0.0f));
+  out.preint_tables.clear();
+  if (scene.preintegration) {
+    out.preint_tables.assign(std::size_t(channels.slot_count()) * 2u * kTfLutSize, glm::vec4(0.0f));
+  }
   // The step (Eq. 8.2-8.3) follows the finest level any sample of a channel can use: its finest
   // allowed level, or the level the LOD picks at the volume's nearest point when that is
   // coarser. Without the LOD floor a distant view of a huge volume would march level-0 steps
@@ -284,6 +290,11 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
 
     const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
     std::copy(lut.begin(), lut.end(), out.tf_luts.begin() + std::ptrdiff_t(*slot) * kTfLutSize);
+    if (scene.preintegration) {
+      const std::vector<glm::vec4> pre = preintegration_table(lut);
+      std::copy(pre.begin(), pre.end(),
+                out.preint_tables.begin() + std::ptrdiff_t(*slot) * 2 * kTfLutSize);
+    }
     const std::uint32_t step_level =
         std::min(std::max(lod_floor, s.finest_level), s.coarsest_level);
     finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, step_level));

@@ -460,7 +460,7 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   r.only_keys(
       doc, "",
       {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity", "background",
-       "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor"});
+       "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor", "preintegration"});
   Scene s;
   s.camera = read_camera(r, r.require(doc, "", "camera"));
   if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
@@ -485,6 +485,10 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
         r.fail(p, "unknown effect '" + e + "' (known: \"shading\", \"shadows\")");
       }
     }
+  }
+  if (const json* v = r.find(doc, "preintegration")) {
+    if (!v->is_boolean()) r.fail("preintegration", "must be true or false");
+    s.preintegration = v->get<bool>();
   }
   detail::read_slices_and_lens(doc, name, s);
   read_effect_options(r, doc, s);
@@ -533,6 +537,8 @@ std::string scene_to_json(const Scene& s) {
   json effects = json::array();
   for (Effect e : s.effects) effects.push_back(to_string(e));
   doc["effects"] = effects;
+  // Written only when on, so that documents of scenes without it are unchanged.
+  if (s.preintegration) doc["preintegration"] = true;
   detail::slices_and_lens_to_json(s, doc);
   effects_to_json(s, doc);
   return doc.dump(2) + "\n";

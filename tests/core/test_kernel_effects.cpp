@@ -54,6 +54,9 @@ inline ResoctDepthInfo resoct_read_depth(uint d) {
 inline vec4 resoct_read_tf(uint slot, uint index) {
   return test::g.tables->tf_luts[std::size_t(slot) * 1024u + index];
 }
+inline vec4 resoct_read_preint(uint slot, uint index) {
+  return test::g.tables->preint_tables[std::size_t(slot) * 2048u + index];
+}
 inline ResoctFxFrame resoct_read_fx_frame() {
   return test::g.tables->fx;
 }

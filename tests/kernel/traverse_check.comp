@@ -35,6 +35,9 @@ layout(std430, binding = 14) readonly buffer Directory {
 layout(std430, binding = 7) readonly buffer TfLuts {
   vec4 tf_entries[];
 };
+layout(std430, binding = 21) readonly buffer PreintTables {
+  vec4 preint_entries[];
+};
 layout(std430, binding = 8) readonly buffer Cache {
   float cache_voxels[];
 };
@@ -80,6 +83,9 @@ ResoctDepthInfo resoct_read_depth(uint d) {
 }
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];
+}
+vec4 resoct_read_preint(uint slot, uint index) {
+  return preint_entries[slot * 2048u + index];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;

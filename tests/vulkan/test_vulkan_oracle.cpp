@@ -87,6 +87,22 @@ TEST(VulkanOracle, ShippedScenesAllModesMatchTheCpuBackend) {
   expect_no_validation_messages(*gpu);
 }
 
+// Pre-integrated transfer functions (kernel/preintegration.glsl.h, the plain pipeline variant
+// with RESOCT_EFFECT_PREINT) at coarse steps, where segments span many LUT bins.
+TEST(VulkanOracle, PreintegratedScenesAllModesMatchTheCpuBackend) {
+  auto gpu = make_validated_vulkan();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  for (const Case& c : {kCases[0], kCases[2], kCases[4]}) {
+    ProceduralSource src(c.spec, small_bricks());
+    Scene scene = shipped_scene(c.name);
+    scene.preintegration = true;
+    scene.step_scale = 2.0;
+    ResidentScene rs(src, scene_channels(scene));
+    compare_all_modes(*gpu, rs, scene, std::string(c.name) + " preint", RequestStrategy::global);
+  }
+  expect_no_validation_messages(*gpu);
+}
+
 TEST(VulkanOracle, MissingFineLevelsGiveTheSameRequests) {
   auto gpu = make_validated_vulkan();
   if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";

@@ -2,8 +2,9 @@
 // (docs/rendering.md "Effects"). Called by traverse.glsl.h only from specializations whose
 // RESOCT_EFFECTS is not 0; the plain kernel never reaches this code.
 //
-//   dvr   TF colour and corrected opacity; with "shading" the colour is Blinn-Phong lit with the
-//         gradient normal, with "shadows" the diffuse and specular terms are scaled by the
+//   dvr   TF colour and corrected opacity (pre-integrated over the segment from the channel's
+//         previous value with RESOCT_EFFECT_PREINT); with "shading" the colour is Blinn-Phong lit
+//         with the gradient normal, with "shadows" the diffuse and specular terms are scaled by the
 //         transmittance of a shadow ray (samples above RESOCT_SHADOW_MIN_ALPHA only).
 //   iso   a crossing of an isovalue between the channel's previous and current sample is refined
 //         on the trilinear cells (isosurface.glsl.h); the surface is composited at the hit,
@@ -24,6 +25,7 @@
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/gradient.glsl.h"
 #include "resoct/kernel/isosurface.glsl.h"
+#include "resoct/kernel/preintegration.glsl.h"
 #include "resoct/kernel/projection.glsl.h"
 #include "resoct/kernel/shadow.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
@@ -126,9 +128,9 @@ RESOCT_FN bool resoct_fx_iso_hit(ResoctSampleParams sp, ResoctFxParams p, Resoct
 RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
                                     uint c, ResoctSlotInfo s, float value, uint level, uint lod,
                                     float seg, float tm, ivec3 cell, vec3 frac,
-                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(vec4) weighted,
-                                    RESOCT_INOUT(float) combined, RESOCT_INOUT(vec4) acc,
-                                    RESOCT_INOUT(ResoctRayStats) st) {
+                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(ResoctPreintRay) pr,
+                                    RESOCT_INOUT(vec4) weighted, RESOCT_INOUT(float) combined,
+                                    RESOCT_INOUT(vec4) acc, RESOCT_INOUT(ResoctRayStats) st) {
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     if (s.mode == RESOCT_CHANNEL_MIP) {
       fx.proj[c] = max(fx.proj[c], clamp(value, 0.0f, 1.0f));
@@ -153,9 +155,17 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
       surface = true;
     }
   }
-  vec4 rgba = resoct_tf_lookup(s.slot, pv);
-  // A surface keeps its TF alpha; a DVR sample's alpha is corrected for the segment.
-  float a = surface ? min(rgba.a, 1.0f) : resoct_correct_opacity(rgba.a, seg / p.ref_step);
+  // A surface keeps its TF alpha; a DVR sample's alpha is corrected for the segment (or comes
+  // from the pre-integrated segment, whose colour shading then multiplies like a point's).
+  vec4 rgba;
+  float a;
+  if (surface) {
+    rgba = resoct_tf_lookup(s.slot, pv);
+    a = min(rgba.a, 1.0f);
+  } else {
+    rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, pv, seg / p.ref_step);
+    a = rgba.a;
+  }
   vec3 rgb = vec3(rgba.r, rgba.g, rgba.b);
   bool lit = surface;
   RESOCT_IF_FX(RESOCT_EFFECT_SHADING) {
@@ -164,6 +174,9 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
   if (lit && a > 0.0f) {
     rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, pl, lod, pc, pf, pv, rgb,
                                      surface || a > RESOCT_SHADOW_MIN_ALPHA, st);
+  }
+  RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+    if (!surface) resoct_preint_set_tail_colour(pr, c, rgb);
   }
   if (surface) {
     acc = resoct_composite(acc, resoct_premultiply(rgb, a));

@@ -37,13 +37,17 @@ layout(constant_id = RESOCT_EFFECTS_CONSTANT_ID) const uint RESOCT_EFFECTS = 0u;
 RESOCT_KERNEL_BEGIN
 
 // Effect bits. SHADING and SHADOWS come from the scene's "effects"; ISO and PROJECTION are set
-// when any channel has mode "iso", respectively "mip" or "aip".
+// when any channel has mode "iso", respectively "mip" or "aip"; PREINT by the scene's
+// "preintegration" (kernel/preintegration.glsl.h).
 RESOCT_CONST(uint, RESOCT_EFFECT_SHADING, 1u);
 RESOCT_CONST(uint, RESOCT_EFFECT_SHADOWS, 2u);
 RESOCT_CONST(uint, RESOCT_EFFECT_ISO, 4u);
 RESOCT_CONST(uint, RESOCT_EFFECT_PROJECTION, 8u);
+RESOCT_CONST(uint, RESOCT_EFFECT_PREINT, 16u);
 /// Masks run 0 .. RESOCT_EFFECT_MASKS - 1 (the CPU backend instantiates each).
-RESOCT_CONST(uint, RESOCT_EFFECT_MASKS, 16u);
+RESOCT_CONST(uint, RESOCT_EFFECT_MASKS, 32u);
+/// The bits whose code runs per channel value in the effect path (resoct_fx_channel).
+/// Pre-integration alone only changes the DVR lookup and stays on the plain path.
 RESOCT_CONST(uint, RESOCT_EFFECT_ANY, 15u);
 
 // Channel modes (ResoctSlotInfo.mode).

@@ -17,6 +17,7 @@
 //   void  resoct_report_node_request(uint node)      a node whose metadata is INVALID
 //   void  resoct_mark_used(uint cache_slot)          the slot was sampled this frame
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
+//   vec4  resoct_read_preint(uint slot, uint index)  (preintegration.glsl.h)
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
 //   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
 //
@@ -40,6 +41,7 @@
 #include "resoct/kernel/node_class.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/preintegration.glsl.h"
 #include "resoct/kernel/projection.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
@@ -141,6 +143,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     rc.live = live;
     fxp = resoct_fx_params(f, resoct_read_fx_frame());
   }
+  // Pre-integration: each channel's previous value (kernel/preintegration.glsl.h).
+  ResoctPreintRay pr;
+  RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+    resoct_preint_ray_clear(pr);
+  }
   float t_enter = t;
 
   // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
@@ -177,6 +184,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
                                             resoct_view_depth(f, dir_box, tm), f.lod_error_px);
       uint lod = resoct_lod_level(budget, f.level_count);
+      RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+        acc = resoct_preint_begin_sample(pr, lod, seg / f.ref_step, acc);
+      }
 
       vec4 weighted;
       float combined;
@@ -374,9 +384,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                 fx_have = fx_have | (1u << c);
               }
               else {
-                vec4 rgba = resoct_tf_lookup(s.slot, value);
-                resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
-                               resoct_correct_opacity(rgba.a, seg / f.ref_step));
+                vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
+                resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
               }
               any_value = true;
             }
@@ -416,9 +425,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               fx_have = fx_have | (1u << c);
             }
             else {
-              vec4 rgba = resoct_tf_lookup(s.slot, value);
-              resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
-                             resoct_correct_opacity(rgba.a, seg / f.ref_step));
+              vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
+              resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
             }
             any_value = true;
           }
@@ -431,8 +439,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           if (((fx_have >> c) & 1u) == 0u) continue;
           RESOCT_FX(resoct_fx_channel)
           (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], lod, seg, tm, cell,
-           frac, fx, weighted, combined, acc, stats);
+           frac, fx, pr, weighted, combined, acc, stats);
         }
+      }
+      RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+        acc = resoct_preint_end_sample(pr, acc);
       }
 
       if (any_value) {
@@ -455,6 +466,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         stats.marched = stats.marched + seg;
         t = resoct_advance_t(t, seg);
       }
+    }
+    RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+      if (!stop) acc = resoct_preint_flush(pr, acc);
     }
     if (stop || segs.enabled == 0u ||
         !resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc, live,

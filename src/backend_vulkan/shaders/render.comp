@@ -66,6 +66,11 @@ layout(std430, binding = 7) readonly buffer TfLuts {
 // The cache is split into up to 8 buffers of whole bricks (chunk c holds slots
 // [c * slots_per_chunk, (c + 1) * slots_per_chunk)), because one storage buffer may not exceed
 // maxStorageBufferRange (128 MiB on some devices). Chunk 0 is binding 8, chunks 1-7 bindings 14-20.
+// Pre-integration tables (kernel/preintegration.glsl.h), 2048 entries per slot; one dummy entry
+// when the frame does not use them.
+layout(std430, binding = 22) readonly buffer PreintTables {
+  vec4 preint_entries[];
+};
 layout(std430, binding = 8) readonly buffer Cache0 {
   uint cache0[];
 };
@@ -173,6 +178,9 @@ ResoctDepthInfo resoct_read_depth(uint d) {
 }
 vec4 resoct_read_tf(uint slot, uint index) {
   return tf_entries[slot * 1024u + index];
+}
+vec4 resoct_read_preint(uint slot, uint index) {
+  return preint_entries[slot * 2048u + index];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;
