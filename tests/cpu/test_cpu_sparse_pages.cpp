@@ -102,8 +102,9 @@ TEST(CpuSparsePages, SmallPoolIsReclaimedWhileTheViewMovesAndStillConverges) {
   RendererOptions o = options(glm::uvec3(16));
   const std::uint64_t slot_bytes =
       source->hierarchy().layout().padded_voxels() * voxel_size(source->volume().type);
-  o.device_cache_bytes = 24 * slot_bytes;
-  o.page_pool_blocks = 25;  // just above the cache slots, far below the table's blocks
+  o.device_cache_bytes = 16 * slot_bytes;
+  // The orbit below touches about 23 blocks, so a pool just above the 16 cache slots must reclaim.
+  o.page_pool_blocks = 17;
   ASSERT_EQ(PageTable::block_count(source->hierarchy(), 1), 589u);
   Renderer r(source, o);
   std::uint32_t full_pool_frames = 0;
@@ -121,7 +122,7 @@ TEST(CpuSparsePages, SmallPoolIsReclaimedWhileTheViewMovesAndStillConverges) {
   }
   EXPECT_GT(full_pool_frames, 0u);
   EXPECT_GT(freed, 0u) << "the pool was never reclaimed";
-  const Scene still = scene_for(8, {1.6, 1.3, 1.9});  // a working set within the 24 slots
+  const Scene still = scene_for(8, {1.6, 1.3, 1.9});  // a working set within the 16 slots
   const ConvergeReport rep = r.render_until_converged(still, 64);
   ASSERT_TRUE(rep.converged) << rep.frames << " frames";
   // The same still view from a cold cache with a pool holding every block (never reclaimed);

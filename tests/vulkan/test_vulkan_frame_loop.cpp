@@ -162,8 +162,10 @@ TEST(VulkanDeltaUploads, BlockAllocationAndReclaimMatchTheHostStateAndConverge) 
   o.backend_options.validation = true;
   o.loader_threads = 0;
   o.leaf_size = glm::uvec3(16);
-  o.device_cache_bytes = 24 * slot_bytes;
-  o.page_pool_blocks = 25;  // above the cache slots, far below the table's 589 blocks
+  o.device_cache_bytes = 16 * slot_bytes;
+  // The orbit below touches about 23 of the 589 blocks, so a pool just above the 16 cache slots
+  // must reclaim.
+  o.page_pool_blocks = 17;
   ASSERT_EQ(PageTable::block_count(source->hierarchy(), 1), 589u);
   Renderer r(source, o);
   auto* gpu = dynamic_cast<vk::VulkanBackend*>(&r.backend());
@@ -186,7 +188,7 @@ TEST(VulkanDeltaUploads, BlockAllocationAndReclaimMatchTheHostStateAndConverge) 
   }
   EXPECT_GT(misses, 0u);
   EXPECT_GT(freed, 0u) << "the pool was never reclaimed";
-  // Converges at a still view (a working set within the 24 slots), with the image of the CPU
+  // Converges at a still view (a working set within the 16 slots), with the image of the CPU
   // backend run the same way.
   s.camera.eye = {1.6, 1.3, 1.9};
   s.viewport = Viewport{8, 8};
