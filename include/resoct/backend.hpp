@@ -125,6 +125,12 @@ struct FrameResult {
 /// "tables". Every backend calls it at the start of render().
 void check_frame_tables(const FrameTables& tables, const BackendConfig& config);
 
+/// Checks the page-table sizes of a backend configuration against the 32-bit device request keys
+/// (kernel/request_key.glsl.h): 1..RESOCT_REQUEST_MAX_POOL_BLOCKS pool blocks and fewer than
+/// 2^31 - 1 directory entries. Throws Error(invalid_argument) naming "config". Every backend
+/// calls it when it is created.
+void check_page_table_config(const BackendConfig& config);
+
 /// A rendering device. Not thread-safe: one Renderer drives it from one thread.
 class Backend {
  public:

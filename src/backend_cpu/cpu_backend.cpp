@@ -56,14 +56,7 @@ void CpuBackend::configure(const BackendConfig& config) {
   if (config.cache_slots > 0 && slot_voxels * vb > (std::size_t(1) << 62) / config.cache_slots) {
     throw invalid_parameter("config", "cache pool byte size overflows");
   }
-  if (config.page_pool_blocks == 0 ||
-      config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
-    throw invalid_parameter("config", "page_pool_blocks must be 1.." +
-                                          std::to_string(kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS));
-  }
-  if (config.directory_entries >= kernel::RESOCT_REQUEST_MAX_DIRECTORY) {
-    throw invalid_parameter("config", "directory_entries must be below 2^31 - 1");
-  }
+  check_page_table_config(config);
   if (config.node_words > (std::uint64_t(1) << 32)) {
     throw invalid_parameter("config", "node_words exceeds 2^32");
   }

@@ -102,14 +102,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   }
   const std::uint64_t cache_bytes =
       (std::uint64_t(config.cache_slots) * slot_voxels * vb + 3) & ~3ull;
-  if (config.page_pool_blocks == 0 ||
-      config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
-    throw invalid_parameter("config", "page_pool_blocks must be 1.." +
-                                          std::to_string(kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS));
-  }
-  if (config.directory_entries >= kernel::RESOCT_REQUEST_MAX_DIRECTORY) {
-    throw invalid_parameter("config", "directory_entries must be below 2^31 - 1");
-  }
+  check_page_table_config(config);
   const std::array<std::pair<std::uint64_t, const char*>, 7> sizes = {{
       {std::uint64_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES * 4,
        "page pool (RendererOptions::page_pool_blocks)"},

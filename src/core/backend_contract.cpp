@@ -4,8 +4,20 @@
 #include "resoct/error.hpp"
 #include "resoct/transfer_function.hpp"
 #include "resoct/kernel/effects.glsl.h"
+#include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct {
+
+void check_page_table_config(const BackendConfig& config) {
+  if (config.page_pool_blocks == 0 ||
+      config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
+    throw invalid_parameter("config", "page_pool_blocks must be 1.." +
+                                          std::to_string(kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS));
+  }
+  if (config.directory_entries >= kernel::RESOCT_REQUEST_MAX_DIRECTORY) {
+    throw invalid_parameter("config", "directory_entries must be below 2^31 - 1");
+  }
+}
 
 void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
   const kernel::ResoctFrame& f = t.frame;
