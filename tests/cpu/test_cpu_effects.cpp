@@ -11,20 +11,13 @@
 #include "cpu_test_util.hpp"
 #include "support/function_source.hpp"
 #include "resoct/error.hpp"
+#include "support/test_views.hpp"
 
 namespace resoct::test {
 namespace {
 
 BrickLayout bricks8(std::uint32_t halo = 1) {
   return BrickLayout{glm::uvec3(8), halo};
-}
-
-Camera oblique() {
-  Camera c;
-  c.eye = {1.9, 1.3, 2.1};
-  c.target = {0.5, 0.5, 0.5};
-  c.fov_deg = 35.0;
-  return c;
 }
 
 std::vector<TfPoint> grey_ramp(double alpha) {
@@ -34,7 +27,7 @@ std::vector<TfPoint> grey_ramp(double alpha) {
 TEST(CpuEffects, SceneWithoutEffectsRunsNoEffectCode) {
   ProceduralSource src("procedural:sphere:32x32x32", bricks8());
   ResidentScene rs(src, {0});
-  Scene s = make_scene(24, oblique());
+  Scene s = make_scene(24, oblique_camera());
   s.channels = {make_channel(0, grey_ramp(0.1))};
   const Rendered plain = render_cpu(rs, s);
   EXPECT_EQ(plain.stats.gradient_evals, 0u);
@@ -85,7 +78,7 @@ TEST(CpuEffects, MipAndAipMatchBruteForceProjections) {
   const VoxelFunction vox = level0_voxels(src);
   for (ChannelMode mode : {ChannelMode::mip, ChannelMode::aip}) {
     ResidentScene rs(src, {0});
-    Scene s = make_scene(20, oblique());
+    Scene s = make_scene(20, oblique_camera());
     s.channels = {make_channel(0, {{0.0, {0, 0, 0, 1}}, {1.0, {1, 1, 1, 1}}}, 0, 0)};
     s.channels[0].mode = mode;
     const Rendered r = render_cpu(rs, s);
@@ -129,7 +122,7 @@ TEST(CpuEffects, ShadingAndIsosurfacesMatchTheReferenceRenderer) {
   const VolumeDesc& v = src.hierarchy().volume();
   const VoxelFunction vox = level0_voxels(src);
   ResidentScene rs(src, {0});
-  Scene s = make_scene(40, oblique());
+  Scene s = make_scene(40, oblique_camera());
   s.light.kind = Light::Kind::directional;
   s.light.vector = {-0.3, -1.0, -0.5};
   s.channels = {make_channel(
@@ -166,7 +159,7 @@ TEST(CpuEffects, MipWithSkippingEqualsMipWithout) {
   no_meta.metadata = false;
   ResidentScene with(src, {0});
   ResidentScene without(src, {0}, no_meta);
-  Scene s = make_scene(32, oblique());
+  Scene s = make_scene(32, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {0, 0, 0, 1}}, {1.0, {1, 0.5, 0.2, 1}}}, 0, 0)};
   for (ChannelMode mode : {ChannelMode::mip, ChannelMode::aip}) {
     s.channels[0].mode = mode;
@@ -192,7 +185,7 @@ TEST(CpuEffects, IsosurfaceAcrossBrickBordersAndLevelTransitions) {
   ResidentOptions part;
   part.brick_resident = [](std::uint32_t level, glm::uvec3 b) { return level > 0 || b.x < 2; };
   ResidentScene partial(src, {0}, part);
-  Scene s = make_scene(40, oblique());
+  Scene s = make_scene(40, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {0.2, 0.6, 1.0, 1}}, {1.0, {0.2, 0.6, 1.0, 1}}}, 0, 15)};
   s.channels[0].mode = ChannelMode::iso;
   s.channels[0].isovalues = {0.5};
@@ -291,7 +284,7 @@ TEST(CpuEffects, SphereShadowOnSlabWhereGeometrySays) {
 TEST(CpuEffects, HaloZeroIsRejectedForGradientEffects) {
   ProceduralSource src("procedural:sphere:16x16x16", BrickLayout{glm::uvec3(8), 0});
   ResidentScene rs(src, {0});
-  Scene s = make_scene(8, oblique());
+  Scene s = make_scene(8, oblique_camera());
   s.channels = {make_channel(0, grey_ramp(0.1))};
   EXPECT_NO_THROW(rs.tables(s));
   s.effects = {Effect::shading};

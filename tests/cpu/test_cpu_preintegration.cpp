@@ -7,24 +7,10 @@
 
 #include "cpu_test_util.hpp"
 #include "support/function_source.hpp"
+#include "support/test_views.hpp"
 
 namespace resoct::test {
 namespace {
-
-BrickLayout bricks8() {
-  BrickLayout l;
-  l.brick_size = glm::uvec3(8);
-  l.halo = 1;
-  return l;
-}
-
-Camera oblique() {
-  Camera c;
-  c.eye = {1.9, 1.3, 2.1};
-  c.target = {0.5, 0.5, 0.5};
-  c.fov_deg = 35.0;
-  return c;
-}
 
 // A narrow, nearly opaque band of values: the sharp transfer function pre-integration is for.
 std::vector<TfPoint> sharp_tf() {
@@ -67,7 +53,7 @@ FunctionSource ball_source() {
 }
 
 Scene ball_scene() {
-  Scene scene = make_scene(48, oblique());
+  Scene scene = make_scene(48, oblique_camera());
   scene.ert_opacity = 1.0;
   scene.channels = {make_channel(0, sharp_tf(), 0, 0)};
   return scene;
@@ -109,7 +95,7 @@ TEST(CpuPreintegration, SharpTfAtCoarseStepsIsFarCloserToTheReference) {
 TEST(CpuPreintegration, TubesWithSharpTfGainAtCoarseSteps) {
   ProceduralSource src("procedural:tubes:32x32x32:1", bricks8());
   ResidentScene rs(src, {0});
-  Scene scene = make_scene(48, oblique());
+  Scene scene = make_scene(48, oblique_camera());
   scene.ert_opacity = 1.0;
   scene.channels = {make_channel(0, sharp_tf())};
   ReferenceOptions ro;
@@ -175,7 +161,7 @@ TEST(CpuPreintegration, OpaqueNanAndInfiniteVoxelsStayFinite) {
                     : double(k) / 10.0 - 0.2;
   });
   ResidentScene rs(src, {0});
-  Scene scene = make_scene(24, oblique());
+  Scene scene = make_scene(24, oblique_camera());
   scene.channels = {
       make_channel(0, {{0.0, {0, 0, 1, 0.0}}, {0.5, {1, 0, 0, 1.0}}, {1.0, {1, 1, 0, 1.0}}}, 0, 0)};
   scene.preintegration = true;

@@ -9,16 +9,10 @@
 
 #include "cpu_test_util.hpp"
 #include "resoct/camera.hpp"
+#include "support/test_views.hpp"
 
 namespace resoct::test {
 namespace {
-
-BrickLayout bricks8() {
-  BrickLayout l;
-  l.brick_size = glm::uvec3(8);
-  l.halo = 1;
-  return l;
-}
 
 // Looks down -z at the middle of the unit box, orthographic, covering `height` box units.
 Camera ortho_down_z(double height) {

@@ -10,16 +10,10 @@
 
 #include "cpu_test_util.hpp"
 #include "resoct/camera.hpp"
+#include "support/test_views.hpp"
 
 namespace resoct::test {
 namespace {
-
-BrickLayout bricks8() {
-  BrickLayout l;
-  l.brick_size = glm::uvec3(8);
-  l.halo = 1;
-  return l;
-}
 
 Camera random_camera(std::mt19937& rng) {
   std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);

@@ -8,24 +8,10 @@
 #include "cpu_test_util.hpp"
 #include "support/expect_error.hpp"
 #include "resoct/camera.hpp"
+#include "support/test_views.hpp"
 
 namespace resoct::test {
 namespace {
-
-BrickLayout small_bricks() {
-  BrickLayout l;
-  l.brick_size = glm::uvec3(8);
-  l.halo = 1;
-  return l;
-}
-
-Camera oblique() {
-  Camera c;
-  c.eye = {1.9, 1.3, 2.1};
-  c.target = {0.5, 0.5, 0.5};
-  c.fov_deg = 35.0;
-  return c;
-}
 
 // Tolerance of the reference match, per colour channel in [0, 1]: the kernel runs in float
 // (≈1e-6 relative per operation over a few hundred samples), interpolates a 1024-entry LUT
@@ -38,7 +24,7 @@ constexpr double kRefRmse = 3e-3;
 
 void expect_matches_reference(const std::string& spec, const Scene& scene,
                               std::vector<std::uint32_t> channels) {
-  ProceduralSource src(spec, small_bricks());
+  ProceduralSource src(spec, bricks8());
   ResidentScene rs(src, channels);
   const Rendered r = render_cpu(rs, scene);
   const Image ref = render_reference(scene, src.hierarchy().volume(), level0_voxels(src));
@@ -51,20 +37,20 @@ void expect_matches_reference(const std::string& spec, const Scene& scene,
 }
 
 TEST(CpuTraverse, ReferenceMatchSphere) {
-  Scene s = make_scene(48, oblique());
+  Scene s = make_scene(48, oblique_camera());
   s.channels = {make_channel(
       0, {{0.0, {1, 1, 1, 0}}, {0.3, {1, 0.6, 0.2, 0.05}}, {1.0, {0.2, 0.4, 1.0, 0.3}}}, 0, 0)};
   expect_matches_reference("procedural:sphere:32x32x32", s, {0});
 }
 
 TEST(CpuTraverse, ReferenceMatchRamp) {
-  Scene s = make_scene(48, oblique());
+  Scene s = make_scene(48, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {0, 0, 0, 0}}, {1.0, {1, 0.5, 0.25, 0.1}}}, 0, 0)};
   expect_matches_reference("procedural:ramp:24x32x16", s, {0});
 }
 
 TEST(CpuTraverse, ReferenceMatchTwoChannels) {
-  Scene s = make_scene(40, oblique());
+  Scene s = make_scene(40, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {1, 0, 0, 0}}, {1.0, {1, 0, 0, 0.08}}}, 0, 0),
                 make_channel(1, {{0.0, {0, 0, 1, 0}}, {1.0, {0, 0.5, 1, 0.08}}}, 0, 0)};
   s.channels[1].importance = -1;  // traversed first; the image must not depend on it
@@ -74,7 +60,7 @@ TEST(CpuTraverse, ReferenceMatchTwoChannels) {
 // A constant medium of reference opacity a along an axis-parallel ray of length L voxels has
 // opacity 1 − (1 − a)^L for every step and at every level.
 TEST(CpuTraverse, ConstantBoxAnalytic) {
-  ProceduralSource src("procedural:constant:32x32x32", small_bricks());
+  ProceduralSource src("procedural:constant:32x32x32", bricks8());
   ResidentScene rs(src, {0});
   const double a = 0.05;
   for (std::uint32_t level : {0u, 2u}) {
@@ -104,7 +90,7 @@ TEST(CpuTraverse, ConstantBoxAnalytic) {
 // Trilinear sampling of a linear ramp is exact everywhere between the outermost voxel centres,
 // including across brick borders (the halo). An opaque identity TF shows the first sample.
 TEST(CpuTraverse, RampExactAcrossBrickBorders) {
-  ProceduralSource src("procedural:ramp:64x8x8", small_bricks());
+  ProceduralSource src("procedural:ramp:64x8x8", bricks8());
   ResidentScene rs(src, {0});
   Camera c;
   c.projection = Projection::orthographic;
@@ -126,7 +112,7 @@ TEST(CpuTraverse, RampExactAcrossBrickBorders) {
 }
 
 Scene tubes_scene(std::uint32_t size) {
-  Scene s = make_scene(size, oblique());
+  Scene s = make_scene(size, oblique_camera());
   s.step_scale = 0.5;
   // A transparent plateau below 0.1: values there (the empty background) can be culled.
   s.channels = {make_channel(0,
@@ -139,7 +125,7 @@ Scene tubes_scene(std::uint32_t size) {
 }
 
 TEST(CpuTraverse, ModesAgreeWhenResident) {
-  ProceduralSource src("procedural:tubes:64x64x64", small_bricks());
+  ProceduralSource src("procedural:tubes:64x64x64", bricks8());
   ResidentScene rs(src, {0});
   const Scene s = tubes_scene(64);
   FrameOptions o;
@@ -177,9 +163,9 @@ TEST(CpuTraverse, ResidencySkipsEmptySpace) {
 }
 
 TEST(CpuTraverse, ImportanceOrderDoesNotChangeTheImage) {
-  ProceduralSource src("procedural:tubes:32x32x32:3", small_bricks());
+  ProceduralSource src("procedural:tubes:32x32x32:3", bricks8());
   ResidentScene rs(src, {0, 1, 2});
-  Scene s = make_scene(32, oblique());
+  Scene s = make_scene(32, oblique_camera());
   for (std::uint32_t c = 0; c < 3; ++c) {
     s.channels.push_back(make_channel(
         c, {{0.0, {0, 0, 0, 0}}, {0.3, {c == 0 ? 1.0 : 0.2, c == 1 ? 1.0 : 0.2, 0.5, 0.2}}}, 0, 0));
@@ -195,12 +181,12 @@ TEST(CpuTraverse, ImportanceOrderDoesNotChangeTheImage) {
 // Only the coarsest level resident: residency mode substitutes it and requests the target;
 // page-table mode renders nothing but requests; the standard octree uses the coarse brick.
 TEST(CpuTraverse, MissingDataSubstitution) {
-  ProceduralSource src("procedural:sphere:32x32x32", small_bricks());
+  ProceduralSource src("procedural:sphere:32x32x32", bricks8());
   const std::uint32_t coarsest = src.hierarchy().level_count() - 1;
   ResidentOptions ro;
   ro.level_resident = [coarsest](std::uint32_t l) { return l == coarsest; };
   ResidentScene rs(src, {0}, ro);
-  Scene s = make_scene(24, oblique());
+  Scene s = make_scene(24, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.4}}}, 0, coarsest)};
   const glm::vec4 bg(0, 0, 0, 1);
   FrameOptions o;
@@ -223,13 +209,13 @@ TEST(CpuTraverse, MissingDataSubstitution) {
 
 // Greedy requests ask for every missing level between the target and the first present one.
 TEST(CpuTraverse, GreedyRequestsCoarserLevels) {
-  ProceduralSource src("procedural:sphere:32x32x32", small_bricks());
+  ProceduralSource src("procedural:sphere:32x32x32", bricks8());
   const std::uint32_t coarsest = src.hierarchy().level_count() - 1;
   ASSERT_GE(coarsest, 2u);
   ResidentOptions ro;
   ro.level_resident = [coarsest](std::uint32_t l) { return l == coarsest; };
   ResidentScene rs(src, {0}, ro);
-  Scene s = make_scene(16, oblique());
+  Scene s = make_scene(16, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 0.4}}}, 0, coarsest)};
   s.lod_error_px = 1e-3;  // target level 0 everywhere
   FrameOptions o;
@@ -249,7 +235,7 @@ TEST(CpuTraverse, GreedyRequestsCoarserLevels) {
 // Without metadata every node is INVALID: the traversal requests node metadata and still
 // renders the same image (treated as not empty).
 TEST(CpuTraverse, InvalidMetadataRequestsNodes) {
-  ProceduralSource src("procedural:tubes:32x32x32", small_bricks());
+  ProceduralSource src("procedural:tubes:32x32x32", bricks8());
   ResidentOptions ro;
   ro.metadata = false;
   ResidentScene rs(src, {0}, ro);
@@ -267,13 +253,13 @@ TEST(CpuTraverse, InvalidMetadataRequestsNodes) {
 // transfer function is visible only above 0.995, which the ramp never reaches, so with the
 // carried class it is never sampled: the same bricks are read as with channel 0 alone.
 TEST(CpuTraverse, InvalidNodesInheritTheNearestAncestorsClass) {
-  ProceduralSource src("procedural:ramp:32x32x32:2", small_bricks());
+  ProceduralSource src("procedural:ramp:32x32x32:2", bricks8());
   ResidentOptions ro;
   ro.leaf_size = glm::uvec3(4);
   ro.metadata_depth = 1;
   ResidentScene rs(src, {0, 1}, ro);
   ASSERT_GT(rs.layout().leaf_depth(), 1u);
-  Scene one = make_scene(24, oblique());
+  Scene one = make_scene(24, oblique_camera());
   one.channels = {
       make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.5, {1, 1, 1, 0}}, {1.0, {1, 0.4, 0.1, 0.3}}}, 0, 0)};
   Scene two = one;
@@ -288,9 +274,9 @@ TEST(CpuTraverse, InvalidNodesInheritTheNearestAncestorsClass) {
 }
 
 TEST(CpuTraverse, FrameTablesSlotOrderAndVisibility) {
-  ProceduralSource src("procedural:ramp:16x16x16:3", small_bricks());
+  ProceduralSource src("procedural:ramp:16x16x16:3", bricks8());
   ResidentScene rs(src, {0, 1, 2});
-  Scene s = make_scene(8, oblique());
+  Scene s = make_scene(8, oblique_camera());
   s.channels = {
       make_channel(0, {{0.0, {1, 1, 1, 0}}, {0.5, {1, 1, 1, 0}}, {0.75, {1, 1, 1, 1}}}, 1, 3),
       make_channel(1, {{0.0, {1, 1, 1, 0}}}, 0, 3), make_channel(2, {{0.0, {1, 1, 1, 0.5}}}, 0, 3)};
@@ -316,9 +302,9 @@ TEST(CpuTraverse, FrameTablesSlotOrderAndVisibility) {
 }
 
 TEST(CpuTraverse, FrameTablesRejectUnmappedChannel) {
-  ProceduralSource src("procedural:ramp:16x16x16:3", small_bricks());
+  ProceduralSource src("procedural:ramp:16x16x16:3", bricks8());
   ResidentScene rs(src, {0});
-  Scene s = make_scene(8, oblique());
+  Scene s = make_scene(8, oblique_camera());
   s.channels = {make_channel(2, {{0.0, {1, 1, 1, 0.5}}})};
   EXPECT_RESOCT_ERROR(rs.tables(s), ErrorCode::invalid_argument, "channels");
   FrameOptions o;
@@ -330,12 +316,12 @@ TEST(CpuTraverse, FrameTablesRejectUnmappedChannel) {
 // OpenMP tiles may run in any order on any thread: the image, statistics and requests must not
 // depend on the thread count.
 TEST(CpuTraverse, ThreadCountDoesNotChangeTheResult) {
-  ProceduralSource src("procedural:sphere:32x32x32", small_bricks());
+  ProceduralSource src("procedural:sphere:32x32x32", bricks8());
   const std::uint32_t coarsest = src.hierarchy().level_count() - 1;
   ResidentOptions ro;
   ro.level_resident = [coarsest](std::uint32_t l) { return l != 0; };
   ResidentScene rs(src, {0}, ro);
-  Scene s = make_scene(40, oblique());
+  Scene s = make_scene(40, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0}}, {1.0, {1, 0.5, 0.2, 0.3}}}, 0, coarsest)};
   s.lod_error_px = 0.5;
   const FrameTables t = rs.tables(s);
@@ -356,7 +342,7 @@ TEST(CpuTraverse, ThreadCountDoesNotChangeTheResult) {
 }
 
 TEST(CpuTraverse, BackendRejectsBadUpdatesAndTables) {
-  ProceduralSource src("procedural:sphere:16x16x16", small_bricks());
+  ProceduralSource src("procedural:sphere:16x16x16", bricks8());
   ResidentScene rs(src, {0});
   cpu::CpuBackend b(1);
   rs.upload(b);
@@ -376,7 +362,7 @@ TEST(CpuTraverse, BackendRejectsBadUpdatesAndTables) {
     u3.directory_deltas = std::span<const PageDelta>(&bad, 1);
     EXPECT_RESOCT_ERROR(b.update(u3), ErrorCode::invalid_argument, "directory delta");
   }
-  Scene s = make_scene(8, oblique());
+  Scene s = make_scene(8, oblique_camera());
   s.channels = {make_channel(0, {{0.0, {1, 1, 1, 0.5}}})};
   FrameTables t = rs.tables(s);
   t.tf_luts.pop_back();
