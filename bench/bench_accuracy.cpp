@@ -44,34 +44,11 @@ namespace {
 using namespace resoct;
 using namespace resoct::bench;
 
-constexpr const char* kNames[] = {"tubes", "turbulence", "cells"};
+constexpr const auto& kNames = kEffectDatasetNames;
 constexpr double kSteps[] = {0.25, 0.5, 1.0, 2.0, 4.0};
 constexpr double kLods[] = {0.5, 1.0, 2.0, 4.0, 8.0};
 const glm::uvec3 kLeaves[] = {glm::uvec3(32), glm::uvec3(16), glm::uvec3(8)};
 constexpr double kErts[] = {0.99, 0.995, 0.999};
-
-std::string spec_for(int dataset) {
-  const Preset p = preset();
-  if (dataset == 2) {
-    return std::string("procedural:cells:") +
-           (p == Preset::smoke   ? "64x64x40"
-            : p == Preset::large ? "512x512x40"
-                                 : "256x256x40") +
-           ":16";
-  }
-  const char* size = p == Preset::smoke   ? "24x24x24"
-                     : p == Preset::large ? "256x256x256"
-                                          : "128x128x128";
-  return std::string("procedural:") + kNames[dataset] + ":" + size + ":1";
-}
-
-std::uint32_t visible_channels(int dataset) {
-  return dataset == 2 ? 4u : 1u;
-}
-
-std::uint32_t image_size() {
-  return preset() == Preset::smoke ? 24u : preset() == Preset::large ? 256u : 128u;
-}
 
 Rig& rig_for(int dataset, int leaf) {
   static std::pair<int, int> key{-1, -1};
@@ -79,8 +56,10 @@ Rig& rig_for(int dataset, int leaf) {
   if (!rig || key != std::pair<int, int>{dataset, leaf}) {
     rig.reset();
     std::vector<std::uint32_t> channels;
-    for (std::uint32_t c = 0; c < visible_channels(dataset); ++c) channels.push_back(c);
-    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32), kLeaves[leaf]);
+    for (std::uint32_t c = 0; c < effect_dataset_visible_channels(dataset); ++c)
+      channels.push_back(c);
+    rig = std::make_unique<Rig>(effect_dataset_spec(dataset), channels, glm::uvec3(32),
+                                kLeaves[leaf]);
     key = {dataset, leaf};
   }
   return *rig;
@@ -123,7 +102,7 @@ const Image& reference_for(int dataset, const Scene& scene) {
   o.step = preset() == Preset::smoke ? 0.25 : 0.125;
   o.early_termination = false;
   return cache[dataset] = test::render_reference(
-             scene, v, level0_voxels(*rig.procedural, visible_channels(dataset)), o);
+             scene, v, level0_voxels(*rig.procedural, effect_dataset_visible_channels(dataset)), o);
 }
 
 void BM_Accuracy(benchmark::State& state) {
@@ -131,7 +110,8 @@ void BM_Accuracy(benchmark::State& state) {
   const int sweep = int(state.range(1));
   const int value = int(state.range(2));
   const int leaf = sweep == 2 ? value : 1;
-  Scene scene = bench_scene(rig_for(dataset, 1), visible_channels(dataset), image_size());
+  Scene scene = bench_scene(rig_for(dataset, 1), effect_dataset_visible_channels(dataset),
+                            effect_dataset_image_size());
   const Image& reference = reference_for(dataset, scene);
   Rig& rig = rig_for(dataset, leaf);
   bool uncorrected = false;

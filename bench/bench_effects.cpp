@@ -39,7 +39,7 @@ namespace {
 using namespace resoct;
 using namespace resoct::bench;
 
-constexpr const char* kNames[] = {"tubes", "turbulence", "cells"};
+constexpr const auto& kNames = kEffectDatasetNames;
 constexpr const char* kConfigs[] = {"plain",
                                     "plain (repeat)",
                                     "shading central",
@@ -56,44 +56,23 @@ constexpr const char* kConfigs[] = {"plain",
                                     "shading central + preintegration"};
 constexpr int kConfigCount = 14;
 
-std::string spec_for(int dataset) {
-  const Preset p = preset();
-  if (dataset == 2) {
-    return std::string("procedural:cells:") +
-           (p == Preset::smoke   ? "64x64x40"
-            : p == Preset::large ? "512x512x40"
-                                 : "256x256x40") +
-           ":16";
-  }
-  const char* size = p == Preset::smoke   ? "24x24x24"
-                     : p == Preset::large ? "256x256x256"
-                                          : "128x128x128";
-  return std::string("procedural:") + kNames[dataset] + ":" + size + ":1";
-}
-
-std::uint32_t visible_channels(int dataset) {
-  return dataset == 2 ? 4u : 1u;
-}
-
-std::uint32_t image_size() {
-  return preset() == Preset::smoke ? 24u : preset() == Preset::large ? 256u : 128u;
-}
-
 Rig& rig_for(int dataset) {
   static int key = -1;
   static std::unique_ptr<Rig> rig;
   if (!rig || key != dataset) {
     rig.reset();
     std::vector<std::uint32_t> channels;
-    for (std::uint32_t c = 0; c < visible_channels(dataset); ++c) channels.push_back(c);
-    rig = std::make_unique<Rig>(spec_for(dataset), channels, glm::uvec3(32), glm::uvec3(16));
+    for (std::uint32_t c = 0; c < effect_dataset_visible_channels(dataset); ++c)
+      channels.push_back(c);
+    rig = std::make_unique<Rig>(effect_dataset_spec(dataset), channels, glm::uvec3(32),
+                                glm::uvec3(16));
     key = dataset;
   }
   return *rig;
 }
 
 Scene config_scene(const Rig& rig, int dataset, int config) {
-  Scene s = bench_scene(rig, visible_channels(dataset), image_size());
+  Scene s = bench_scene(rig, effect_dataset_visible_channels(dataset), effect_dataset_image_size());
   s.light.kind = Light::Kind::directional;
   s.light.vector = {-0.6, -1.0, -0.3};
   auto shadows = [&](std::uint32_t factor) {

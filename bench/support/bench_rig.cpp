@@ -87,6 +87,29 @@ Preset preset() {
   return g_preset;
 }
 
+std::string effect_dataset_spec(int dataset) {
+  const Preset p = preset();
+  if (dataset == 2) {
+    return std::string("procedural:cells:") +
+           (p == Preset::smoke   ? "64x64x40"
+            : p == Preset::large ? "512x512x40"
+                                 : "256x256x40") +
+           ":16";
+  }
+  const char* size = p == Preset::smoke   ? "24x24x24"
+                     : p == Preset::large ? "256x256x256"
+                                          : "128x128x128";
+  return std::string("procedural:") + kEffectDatasetNames[dataset] + ":" + size + ":1";
+}
+
+std::uint32_t effect_dataset_visible_channels(int dataset) {
+  return dataset == 2 ? 4u : 1u;
+}
+
+std::uint32_t effect_dataset_image_size() {
+  return preset() == Preset::smoke ? 24u : preset() == Preset::large ? 256u : 128u;
+}
+
 const char* to_string(Preset p) {
   switch (p) {
     case Preset::smoke: return "smoke";

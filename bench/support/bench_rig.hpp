@@ -34,6 +34,16 @@ int run_benchmarks(int argc, char** argv);
 Preset preset();
 const char* to_string(Preset p);
 
+/// The datasets of bench_accuracy and bench_effects, indexed 0..2: procedural tubes and
+/// turbulence (one channel) and the cells slab (16 markers, the first 4 shown), sized by preset().
+inline constexpr const char* kEffectDatasetNames[] = {"tubes", "turbulence", "cells"};
+/// The source spec of effect dataset `dataset` at the current preset.
+std::string effect_dataset_spec(int dataset);
+/// Channels the benchmarks show of effect dataset `dataset`.
+std::uint32_t effect_dataset_visible_channels(int dataset);
+/// Square image edge of those benchmarks at the current preset.
+std::uint32_t effect_dataset_image_size();
+
 /// The backend under test ("cpu" unless RESOCT_BENCH_BACKEND or --backend says otherwise).
 const std::string& backend_name();
 /// A new backend under test; `threads` is honoured by the CPU backend (<= 0: all cores).
