@@ -114,7 +114,11 @@ class PageTable {
   PageLookup translate(std::uint32_t level, std::uint32_t slot, const glm::dvec3& p) const;
 
   void set_mapped(const PageAddress& a, std::uint32_t cache_slot);
+  /// Marks a brick of only zeros (EMPTY, payload 0).
   void set_empty(const PageAddress& a);
+  /// Marks a brick without any finite value (EMPTY, payload 1): transparent whatever the
+  /// transfer function shows at 0.
+  void set_no_finite(const PageAddress& a);
   void set_unmapped(const PageAddress& a);
   /// Marks a constant brick. The device entry holds the value as unorm16 of `range`; the exact
   /// value is kept on the host (homogeneous_value()).

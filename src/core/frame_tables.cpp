@@ -117,6 +117,18 @@ void fill_effects(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFxF
 }
 
 // The slot's mode, isovalues and the visible range the node culling tests (projection.glsl.h).
+// Whether the kernel's LUT lookup (kernel/tf.glsl.h) can give raw value 0 any opacity: both LUT
+// entries it interpolates between are tested, so the answer is conservative.
+void fill_slot_zero(const ChannelSettings& c, const std::vector<glm::vec4>& lut,
+                    kernel::ResoctSlotInfo& s) {
+  s.zero_value = (0.0f - s.range_lo) * s.inv_range_width;  // resoct_normalize_value(0)
+  s.zero_visible = 0u;
+  if (c.mode != ChannelMode::dvr || !(s.zero_value == s.zero_value) || lut.size() < 2) return;
+  const float x = std::clamp(s.zero_value, 0.0f, 1.0f) * float(lut.size() - 1);
+  const std::size_t i0 = std::min(std::size_t(x), lut.size() - 2);
+  if (lut[i0].a > 0.0f || lut[i0 + 1].a > 0.0f) s.zero_visible = 1u;
+}
+
 void fill_slot_effects(const ChannelSettings& c, kernel::ResoctSlotInfo& s) {
   s.mode = c.mode == ChannelMode::iso   ? kernel::RESOCT_CHANNEL_ISO
            : c.mode == ChannelMode::mip ? kernel::RESOCT_CHANNEL_MIP
@@ -286,9 +298,10 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     s.range_lo = float(r.lo);
     s.inv_range_width = float(1.0 / (r.hi - r.lo));
     fill_slot_effects(c, s);
+    const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
+    fill_slot_zero(c, lut, s);
     out.slots.push_back(s);
 
-    const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
     std::copy(lut.begin(), lut.end(), out.tf_luts.begin() + std::ptrdiff_t(*slot) * kTfLutSize);
     if (scene.preintegration) {
       const std::vector<glm::vec4> pre = preintegration_table(lut);

@@ -268,6 +268,10 @@ void PageTable::set_empty(const PageAddress& a) {
   store(a, k::RESOCT_PAGE_EMPTY_WORD);
 }
 
+void PageTable::set_no_finite(const PageAddress& a) {
+  store(a, k::RESOCT_PAGE_EMPTY_NAN_WORD);
+}
+
 void PageTable::set_unmapped(const PageAddress& a) {
   store(a, k::RESOCT_PAGE_UNMAPPED_WORD);
 }

@@ -222,8 +222,12 @@ bool Renderer::apply_one(const LoadedBrick& b, FrameStats& stats) {
   const HostBrick& hb = *b.brick;
   const PageAddress addr = *channels_.address_of(hb.key);
   if (hb.meta.constant) {
-    // A brick of only NaN (min = +inf) has nothing to sample either; it is mapped EMPTY.
-    if (hb.meta.all_zero() || !(hb.meta.min <= hb.meta.max)) {
+    // A brick of only NaN (min = +inf) has nothing to sample either: EMPTY, marked as holding no
+    // finite value so that it stays transparent where the transfer function shows 0.
+    if (!(hb.meta.min <= hb.meta.max)) {
+      pages_.set_no_finite(addr);
+      ++stats.pages_empty;
+    } else if (hb.meta.all_zero()) {
       pages_.set_empty(addr);
       ++stats.pages_empty;
     } else {

@@ -62,20 +62,82 @@ RESOCT_FN float resoct_box_exit(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, v
   return resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), dir_vox, size).y;
 }
 
-/// The value of a present (not UNMAPPED) page entry.
-RESOCT_FN uint resoct_entry_value(ResoctSlotInfo s, uint entry, ResoctLevelInfo L, uvec3 brick_size,
-                                  uint halo, uvec3 brick, ivec3 cell, vec3 frac,
-                                  RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
-  value = 0.0f;
+/// Whether an EMPTY page entry renders: a brick of zeros where the transfer function shows 0
+/// (ResoctSlotInfo.zero_visible). A brick without finite values never does.
+RESOCT_FN bool resoct_empty_page_shows(ResoctSlotInfo s, uint entry) {
+  return s.zero_visible != 0u && resoct_page_payload(entry) == 0u;
+}
+
+/// What one channel yields over a ray *segment*: the part of the ray in which everything the
+/// channel's lookup decides (level, page entry, substitution, requests, used slot) stays the same.
+/// The march (traverse.glsl.h) decides a source once per segment and then only samples it.
+struct ResoctSource {
+  uint kind;        // RESOCT_CH_NONE (nothing), RESOCT_CH_VALUE (constant `value` or, with
+                    // cache_slot != RESOCT_SOURCE_NO_SLOT, a mapped brick), RESOCT_CH_EMPTY
+  float value;      // the constant (normalized) value
+  uint cache_slot;  // mapped brick's cache slot, or RESOCT_SOURCE_NO_SLOT
+  uint level;       // level of the brick sampled
+  uvec3 brick;      // brick coordinates at that level
+};
+
+RESOCT_CONST(uint, RESOCT_SOURCE_NO_SLOT, 0xFFFFFFFFu);
+
+RESOCT_FN ResoctSource resoct_source_of(uint kind, float value) {
+  ResoctSource src;
+  src.kind = kind;
+  src.value = value;
+  src.cache_slot = RESOCT_SOURCE_NO_SLOT;
+  src.level = 0u;
+  src.brick = uvec3(0u);
+  return src;
+}
+
+/// Shrinks the integer box [lo, hi) to its intersection with [blo, bhi).
+RESOCT_FN void resoct_box_clip(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi, ivec3 blo,
+                               ivec3 bhi) {
+  lo = max(lo, blo);
+  hi = min(hi, bhi);
+}
+
+/// Clips [lo, hi) to the level-0 box of a brick of level L.
+RESOCT_FN void resoct_box_clip_brick(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
+                                     ResoctLevelInfo L, uvec3 brick_size, uvec3 brick) {
+  ivec3 blo = resoct_brick_lo0(L, brick_size, brick);
+  resoct_box_clip(lo, hi, blo, blo + ivec3(resoct_brick_size0(L, brick_size)));
+}
+
+/// The source of a present (not UNMAPPED) page entry of `level`; marks a mapped brick's cache
+/// slot used (once per segment).
+RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint level, uvec3 brick) {
   uint state = resoct_page_state(entry);
-  if (state == RESOCT_PAGE_STATE_EMPTY) return RESOCT_CH_EMPTY;
-  if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
-    value = resoct_page_homogeneous_value(entry);
-    return RESOCT_CH_VALUE;
+  if (state == RESOCT_PAGE_STATE_EMPTY) {
+    if (!resoct_empty_page_shows(s, entry)) return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
+    return resoct_source_of(RESOCT_CH_VALUE, s.zero_value);
   }
-  if (state != RESOCT_PAGE_STATE_MAPPED) return RESOCT_CH_NONE;
+  if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
+    return resoct_source_of(RESOCT_CH_VALUE, resoct_page_homogeneous_value(entry));
+  }
+  if (state != RESOCT_PAGE_STATE_MAPPED) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
+  ResoctSource src = resoct_source_of(RESOCT_CH_VALUE, 0.0f);
+  src.cache_slot = resoct_page_cache_slot(entry);
+  src.level = level;
+  src.brick = brick;
+  resoct_mark_used(src.cache_slot);
+  return src;
+}
+
+/// The value of a source at a level-0 position inside its segment: RESOCT_CH_VALUE with `value`
+/// (a trilinear sample of a mapped brick through its halo, or the constant), else the kind.
+RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSlotInfo s, ResoctSource src,
+                                    ivec3 cell, vec3 frac, RESOCT_OUT(float) value,
+                                    RESOCT_INOUT(ResoctRayStats) st) {
+  value = src.value;
+  if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
   st.brick_accesses = st.brick_accesses + 1u;
-  float raw = resoct_sample_mapped(entry, L, brick_size, halo, brick, cell, frac);
+  float raw = resoct_sample_cache(
+      src.cache_slot, resoct_padded_position(resoct_read_level(src.level),
+                                             resoct_frame_brick_size(f), f.halo, src.brick, cell,
+                                             frac));
   value = resoct_normalize_value(raw, s.range_lo, s.inv_range_width);
   return RESOCT_CH_VALUE;
 }
@@ -108,24 +170,29 @@ RESOCT_FN void resoct_request_missing(ResoctSampleParams f, ResoctSlotInfo s, ui
 
 /// Residency mode, one non-empty channel at the traversal node: the target level if present,
 /// else request it and substitute the nearest partially resident level, coarser first, then
-/// finer, checking the actual page entry at the position for each candidate.
-RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, uint node,
-                                        uint target, ivec3 cell, vec3 frac,
-                                        RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
-                                        RESOCT_INOUT(ResoctRayStats) st) {
-  value = 0.0f;
+/// finer, checking the actual page entry at the position for each candidate. [lo, hi) is clipped
+/// to the box in which this answer holds: the target brick (coarser bricks contain it; requests
+/// and greedy requests are the same everywhere in it), and for a substitute also the node (its
+/// residency word chose the candidates) and a finer substitute's brick.
+RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotInfo s, uint node,
+                                               ivec3 node_lo, ivec3 node_hi, uint target,
+                                               ivec3 cell, RESOCT_INOUT(uint) last_key,
+                                               RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
+                                               RESOCT_INOUT(ResoctRayStats) st) {
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(target);
   uvec3 b = resoct_brick_at(L, bs, cell);
+  resoct_box_clip_brick(lo, hi, L, bs, b);
   uint e = resoct_page_entry_of(s.slot, target, f.level_count, L, b);
   if (resoct_page_state(e) != RESOCT_PAGE_STATE_UNMAPPED) {
-    return resoct_entry_value(s, e, L, bs, f.halo, b, cell, frac, value, st);
+    return resoct_entry_source(s, e, target, b);
   }
   resoct_request_missing(f, s, target, cell, last_key, st);
+  resoct_box_clip(lo, hi, node_lo, node_hi);
   uint r =
       resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) + RESOCT_NODE_RESIDENCY) &
       resoct_allowed_levels(s);
-  if (r == 0u) return RESOCT_CH_NONE;
+  if (r == 0u) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
   int l = resoct_node_next_coarser(r, target);
   while (l >= 0) {
     uint lu = uint(l);
@@ -133,7 +200,7 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
     uvec3 bc = resoct_brick_at(Lc, bs, cell);
     uint ec = resoct_page_entry_of(s.slot, lu, f.level_count, Lc, bc);
     if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_entry_value(s, ec, Lc, bs, f.halo, bc, cell, frac, value, st);
+      return resoct_entry_source(s, ec, lu, bc);
     }
     l = resoct_node_next_coarser(r, lu);
   }
@@ -142,50 +209,67 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
     uint lu = uint(l);
     ResoctLevelInfo Lf = resoct_read_level(lu);
     uvec3 bf = resoct_brick_at(Lf, bs, cell);
+    resoct_box_clip_brick(lo, hi, Lf, bs, bf);
     uint ef = resoct_page_entry_of(s.slot, lu, f.level_count, Lf, bf);
     if (resoct_page_state(ef) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_entry_value(s, ef, Lf, bs, f.halo, bf, cell, frac, value, st);
+      return resoct_entry_source(s, ef, lu, bf);
     }
     l = resoct_node_next_finer(r, lu);
   }
-  return RESOCT_CH_NONE;
+  return resoct_source_of(RESOCT_CH_NONE, 0.0f);
 }
 
-/// Page-table mode, one channel: the target level or nothing (requested). `skip_exit` receives
-/// the exit offset of an EMPTY brick.
-RESOCT_FN uint resoct_pagetable_channel(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                        ivec3 cell, vec3 frac, vec3 dir_vox,
+/// Residency mode at one position (slices, shadow rays): resoct_residency_source, sampled.
+RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, uint node,
+                                        uint target, ivec3 cell, vec3 frac,
                                         RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
-                                        RESOCT_OUT(float) skip_exit,
                                         RESOCT_INOUT(ResoctRayStats) st) {
+  ivec3 lo = cell;
+  ivec3 hi = cell + ivec3(1);
+  ResoctSource src = resoct_residency_source(f, s, node, lo, hi, target, cell, last_key, lo, hi, st);
+  return resoct_source_sample(f, s, src, cell, frac, value, st);
+}
+
+/// Page-table mode, one channel: the target level or nothing (requested); [lo, hi) is clipped to
+/// the target brick. `skip_exit` receives the exit offset of an EMPTY brick.
+RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
+                                               ivec3 cell, vec3 frac, vec3 dir_vox,
+                                               RESOCT_INOUT(uint) last_key,
+                                               RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
+                                               RESOCT_OUT(float) skip_exit,
+                                               RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
   ResoctLevelInfo L = resoct_read_level(target);
   uvec3 b = resoct_brick_at(L, bs, cell);
+  resoct_box_clip_brick(lo, hi, L, bs, b);
   uint e = resoct_page_entry_of(s.slot, target, f.level_count, L, b);
   if (resoct_page_state(e) == RESOCT_PAGE_STATE_UNMAPPED) {
-    value = 0.0f;
     resoct_request_missing(f, s, target, cell, last_key, st);
-    return RESOCT_CH_NONE;
+    return resoct_source_of(RESOCT_CH_NONE, 0.0f);
   }
-  uint res = resoct_entry_value(s, e, L, bs, f.halo, b, cell, frac, value, st);
-  if (res == RESOCT_CH_EMPTY) {
+  ResoctSource src = resoct_entry_source(s, e, target, b);
+  if (src.kind == RESOCT_CH_EMPTY) {
     skip_exit =
         resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b), resoct_brick_size0(L, bs));
   }
-  return res;
+  return src;
 }
 
 /// Standard-octree mode, one channel: walk the levels from the slot's coarsest to the target at
 /// the position (one node per level); the first missing level is requested and ends the walk,
-/// the finest present level above it is sampled; an EMPTY level makes the channel empty there.
-RESOCT_FN uint resoct_octree_channel(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                     ivec3 cell, vec3 frac, vec3 dir_vox,
-                                     RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
-                                     RESOCT_OUT(float) skip_exit, RESOCT_INOUT(ResoctRayStats) st) {
-  value = 0.0f;
+/// the finest present level above it is sampled; an EMPTY level that does not show ends it with
+/// the channel empty there. [lo, hi) is clipped to the target brick, which every brick of the
+/// walk contains.
+RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
+                                            ivec3 cell, vec3 frac, vec3 dir_vox,
+                                            RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
+                                            RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
+                                            RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
+  resoct_box_clip_brick(lo, hi, resoct_read_level(target), bs,
+                        resoct_brick_at(resoct_read_level(target), bs, cell));
   uint best_entry = RESOCT_PAGE_UNMAPPED_WORD;
   uint best_level = 0u;
   uvec3 best_brick = uvec3(0u);
@@ -201,18 +285,17 @@ RESOCT_FN uint resoct_octree_channel(ResoctSampleParams f, ResoctSlotInfo s, uin
       resoct_request_missing(f, s, l, cell, last_key, st);
       break;
     }
-    if (state == RESOCT_PAGE_STATE_EMPTY) {
+    if (state == RESOCT_PAGE_STATE_EMPTY && !resoct_empty_page_shows(s, e)) {
       skip_exit = resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b),
                                   resoct_brick_size0(L, bs));
-      return RESOCT_CH_EMPTY;
+      return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
     }
     best_entry = e;
     best_level = l;
     best_brick = b;
   }
-  if (best_entry == RESOCT_PAGE_UNMAPPED_WORD) return RESOCT_CH_NONE;
-  return resoct_entry_value(s, best_entry, resoct_read_level(best_level), bs, f.halo, best_brick,
-                            cell, frac, value, st);
+  if (best_entry == RESOCT_PAGE_UNMAPPED_WORD) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
+  return resoct_entry_source(s, best_entry, best_level, best_brick);
 }
 
 RESOCT_KERNEL_END

@@ -165,6 +165,12 @@ struct ResoctSlotInfo {
   float iso1;
   float iso2;
   float iso3;
+  // An EMPTY page is a brick of only zeros (kernel/page_entry.glsl.h). zero_visible = 1 when the
+  // transfer function may show raw value 0 (its normalized value zero_value): such a page is then
+  // sampled as the constant zero_value instead of being skipped, so an image never depends on
+  // which all-zero bricks exist. Set for "dvr" channels only.
+  uint zero_visible;
+  float zero_value;
 };
 
 // One brick-hierarchy level.

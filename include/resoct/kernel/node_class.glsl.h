@@ -53,8 +53,7 @@ RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
   uint state = resoct_node_state(flags);
   if (state == RESOCT_NODE_INVALID) return RESOCT_NODE_CLASS_INVALID;
   uint minmax = resoct_read_node(base + RESOCT_NODE_MINMAX);
-  uint occupancy = resoct_read_node(base + RESOCT_NODE_OCCUPANCY);
-  if (!resoct_node_may_be_visible(minmax, occupancy, s.vis_lo16, s.vis_hi16, s.vis_bins)) {
+  if (!resoct_node_range_visible(minmax, s.vis_lo16, s.vis_hi16, s.vis_bins)) {
     return RESOCT_NODE_CLASS_EMPTY;
   }
   if (state == RESOCT_NODE_VALID && resoct_node_min16(minmax) == resoct_node_max16(minmax)) {
@@ -141,6 +140,21 @@ RESOCT_FN uint resoct_level_depth_cap(uint start_depth, uint depth_count, uvec3 
     depth = d;
   }
   return depth;
+}
+
+/// Per axis, how far inside a node (in level-0 voxels) the trilinear support of a sample of a
+/// level with factors `factor_log2` stays within the node dilated by one level-0 voxel, the box
+/// node metadata describes: half a level voxel, 2^(f-1), for f >= 1, and 0 at level 0. Level-l
+/// voxel i averages level-0 voxels [i 2^f, (i + 1) 2^f), and a sample at level-0 x interpolates
+/// level voxels floor(x / 2^f - 1/2) and the next; for node faces on the level's voxel grid
+/// (nodes span at least two level voxels) those lie inside the dilated node exactly when x is at
+/// least 2^(f-1) from both faces. docs/rendering.md "Exact culling".
+RESOCT_FN int resoct_half_level_voxel(uint factor_log2) {
+  return factor_log2 == 0u ? 0 : int(1u << (factor_log2 - 1u));
+}
+RESOCT_FN ivec3 resoct_culling_margin(uvec3 factor_log2) {
+  return ivec3(resoct_half_level_voxel(factor_log2.x), resoct_half_level_voxel(factor_log2.y),
+               resoct_half_level_voxel(factor_log2.z));
 }
 
 RESOCT_KERNEL_END

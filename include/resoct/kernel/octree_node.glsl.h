@@ -102,6 +102,26 @@ RESOCT_FN bool resoct_node_may_be_visible(uint minmax, uint occupancy, uint vis_
   return (occupancy & vis_bins) != 0u;
 }
 
+/// Occupancy bins spanned by a record's [min16, max16]: bin k holds normalized values
+/// [k / 32, (k + 1) / 32), i.e. unorm16 values u with u >> 11 == k (as resoct_occupancy_bin).
+RESOCT_FN uint resoct_node_range_bins(uint minmax) {
+  uint a = resoct_node_min16(minmax) >> 11u;
+  uint b = resoct_node_max16(minmax) >> 11u;
+  uint upto_b = b >= 31u ? 0xFFFFFFFFu : ((1u << (b + 1u)) - 1u);
+  return upto_b & ~((1u << a) - 1u);
+}
+
+/// Exact culling: whether any value a sample inside the record's box can take may be visible.
+/// A trilinear sample (of any level: coarser voxels average finer ones) lies between the minimum
+/// and the maximum of the voxels it interpolates, and every value between them can occur, so the
+/// test is the whole range [min16, max16] against the transfer function's visible hull and bins,
+/// never the occupancy bins (values between two occupied bins are not occupied, yet sampled).
+RESOCT_FN bool resoct_node_range_visible(uint minmax, uint vis_lo16, uint vis_hi16, uint vis_bins) {
+  if (resoct_node_range_empty(minmax)) return false;
+  if (resoct_node_min16(minmax) > vis_hi16 || resoct_node_max16(minmax) < vis_lo16) return false;
+  return (resoct_node_range_bins(minmax) & vis_bins) != 0u;
+}
+
 RESOCT_KERNEL_END
 
 #endif  // RESOCT_KERNEL_OCTREE_NODE_GLSL_H

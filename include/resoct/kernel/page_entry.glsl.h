@@ -4,10 +4,11 @@
 //   bits 30-31  state: UNMAPPED (0), MAPPED (1), EMPTY (2), HOMOGENEOUS (3)
 //   bits  0-29  payload:
 //               MAPPED       cache slot index, 0 .. RESOCT_PAGE_MAX_CACHE_SLOT
-//               EMPTY        0 (the brick is constant zero: transparent for every transfer
-//               function) HOMOGENEOUS  bits 0-15 the constant value as unorm16 of the channel's
-//               value range,
-//                            bits 16-29 zero
+//               EMPTY        0: the brick is constant zero (transparent unless the transfer
+//                            function shows 0, ResoctSlotInfo.zero_visible); 1: the brick
+//                            holds no finite value (transparent for every transfer function)
+//               HOMOGENEOUS  bits 0-15 the constant value as unorm16 of the channel's
+//                            value range, bits 16-29 zero
 //               UNMAPPED     0
 // UNMAPPED is the all-zero word so that a zero-filled buffer is a valid, empty page table.
 //
@@ -32,6 +33,7 @@ RESOCT_CONST(uint, RESOCT_PAGE_MAX_CACHE_SLOT, 0x3FFFFFFFu);
 RESOCT_CONST(uint, RESOCT_PAGE_HOMOGENEOUS_MASK, 0xFFFFu);
 RESOCT_CONST(uint, RESOCT_PAGE_UNMAPPED_WORD, 0u);
 RESOCT_CONST(uint, RESOCT_PAGE_EMPTY_WORD, 0x80000000u);
+RESOCT_CONST(uint, RESOCT_PAGE_EMPTY_NAN_WORD, 0x80000001u);
 
 RESOCT_FN uint resoct_page_state(uint entry) {
   return entry >> RESOCT_PAGE_STATE_SHIFT;

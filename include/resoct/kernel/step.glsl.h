@@ -90,6 +90,20 @@ RESOCT_FN uint resoct_lod_level(float budget_log2, uint level_count) {
   return level;
 }
 
+/// The ray parameter from which resoct_lod_level can pick a level coarser than `lod`, for a ray
+/// whose view depth grows by `depth_per_t` per unit t (resoct_view_depth at t = 1); infinite
+/// when it never does (orthographic views, the coarsest level). A segment ends there, and the
+/// next sample chooses its level anew.
+RESOCT_FN float resoct_lod_change_t(float footprint_base, float footprint_slope, float depth_per_t,
+                                    float lod_error_px, uint lod, uint level_count) {
+  if (lod + 1u >= level_count || !(footprint_slope * depth_per_t * lod_error_px > 0.0f)) {
+    return RESOCT_RAY_T_INF;
+  }
+  RESOCT_PRECISE float footprint = exp2(resoct_read_level_size_log2(lod + 1u)) / lod_error_px;
+  RESOCT_PRECISE float depth = (footprint - footprint_base) / footprint_slope;
+  return depth / depth_per_t;
+}
+
 /// A channel's target level: the shared LOD level clamped to its allowed [finest, coarsest].
 RESOCT_FN uint resoct_channel_level(uint lod_level, uint finest, uint coarsest) {
   return min(max(lod_level, finest), max(finest, coarsest));

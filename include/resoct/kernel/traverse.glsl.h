@@ -166,6 +166,25 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   // extra loop back-edges per step, which count against the driver's per-invocation loop guard
   // (docs/vulkan-backend.md) and cut long rays short.
   bool stop = false;
+  // The current ray segment (docs/rendering.md "Segments"): while a sample's cell lies in
+  // [seg_lo, seg_hi) but not in [ex_lo, ex_hi), and before seg_t_end (where the LOD level
+  // changes), every channel's lookup (classification, level, page entry, substitution, requests,
+  // used slot) is that of the segment's first sample, kept in src[]: the samples in between only
+  // sample, look up the transfer function and composite.
+  bool have_seg = false;
+  ivec3 seg_lo = ivec3(0);
+  ivec3 seg_hi = ivec3(0);
+  ivec3 ex_lo = ivec3(0);
+  ivec3 ex_hi = ivec3(0);
+  float seg_t_end = 0.0f;
+  uint seg_lod = 0u;
+  uint seg_node = 0u;
+  ResoctSource src[RESOCT_MAX_SLOTS];
+  // Residency mode: half a voxel of the coarsest level a live channel samples, per axis (0 at
+  // level 0): node metadata covers the node dilated by one level-0 voxel, which covers the
+  // trilinear support of a level-l sample only this far inside the node (docs/rendering.md
+  // "Exact culling").
+  ivec3 margin = ivec3(0);
   for (;;) {
     while (t_exit - t > RESOCT_SEGMENT_EPS * dt) {
       if (stats.iterations >= f.max_iterations) {
@@ -181,269 +200,314 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
       resoct_clamp_position(f, cell, frac);
 
-      float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
-                                            resoct_view_depth(f, dir_box, tm), f.lod_error_px);
-      uint lod = resoct_lod_level(budget, f.level_count);
-      RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-        acc = resoct_preint_begin_sample(pr, lod, seg / f.ref_step, acc);
-      }
-
-      vec4 weighted;
-      float combined;
-      resoct_mix_begin(weighted, combined);
-      bool any_value = false;
       bool skip = false;
-      // Effects: the channels' values are collected and handled by one call below, so the GPU
-      // compiler inlines the effect code once, not once per render mode.
-      float fx_value[RESOCT_MAX_SLOTS];
-      uint fx_level[RESOCT_MAX_SLOTS];
-      uint fx_have = 0u;
       float skip_exit = RESOCT_RAY_T_INF;
+      if (!have_seg || !(tm < seg_t_end) || any(lessThan(cell, seg_lo)) ||
+          any(greaterThanEqual(cell, seg_hi)) ||
+          (all(greaterThanEqual(cell, ex_lo)) && all(lessThan(cell, ex_hi)))) {
+        // ---- A new segment: decide every channel's source at this sample. ----
+        float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
+                                              resoct_view_depth(f, dir_box, tm), f.lod_error_px);
+        uint lod = resoct_lod_level(budget, f.level_count);
+        seg_lod = lod;
+        seg_t_end = resoct_lod_change_t(f.footprint_base, f.footprint_slope,
+                                        resoct_view_depth(f, dir_box, 1.0f), f.lod_error_px, lod,
+                                        f.level_count);
+        seg_lo = ivec3(-2147483647);
+        seg_hi = ivec3(2147483647);
+        ex_lo = ivec3(0);
+        ex_hi = ivec3(0);
+        have_seg = true;
+        for (uint c = 0u; c < n; ++c) src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
 
-      if (f.mode == RESOCT_MODE_RESIDENCY) {
-        // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
-        // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
-        // The LOD level changes rarely along a ray; a new segment (cached_node reset) may
-        // change the bank and with it the channels' level ranges.
-        if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
-          cap_lod = lod;
-          uint cap_level = RESOCT_NONE_U;
-          for (uint c = 0u; c < n; ++c) {
-            if (((live >> c) & 1u) == 0u) continue;
-            ResoctSlotInfo s = resoct_read_slot(bank + c);
-            cap_level = min(cap_level, resoct_channel_level(lod, s.finest_level, s.coarsest_level));
-          }
-          if (cap_level == RESOCT_NONE_U) cap_level = lod;
-          cap_depth = min(trav_depth, resoct_level_depth_cap(
-                                          f.start_depth, f.depth_count,
-                                          resoct_level_factor(resoct_read_level(cap_level))));
-        }
-        // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
-        bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
-                         all(greaterThanEqual(cell, cached_lo)) && all(lessThan(cell, cached_hi));
-        if (!same_node) {
-          ResoctDepthInfo Dt = resoct_read_depth(cap_depth);
-          uvec3 trav_coord = resoct_node_coord(Dt, cell);
-          uvec3 trav_log2 = resoct_depth_count_log2(Dt);
-          uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
-          cached_lo = ivec3(trav_coord * ne);
-          cached_hi = cached_lo + ivec3(ne);
-          cached_coord = trav_coord;
-          // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
-          // node advances the channel index in the same node. `state` = channels empty so far
-          // (always channels 0 .. ci - 1). The descent restarts below the deepest node it
-          // shares with the previous descent's path (whose results depend only on that node and
-          // its ancestors), except for projection channels, whose class follows the running
-          // value along the ray.
-          uint reuse_end = cached_node == RESOCT_NONE_U ? RESOCT_NONE_U : path_end;
-          RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-            reuse_end = RESOCT_NONE_U;
-          }
-          bool on_path = reuse_end != RESOCT_NONE_U;
-          cached_depth = cap_depth;
-          cached_homog = 0u;
-          cached_skip_depth = RESOCT_NONE_U;
-          uint state = 0u;
-          uint local = 0u;
-          for (uint d = 0u; d <= cap_depth; ++d) {
-            ResoctDepthInfo D = resoct_read_depth(d);
-            if (d > 0u) {
-              local = (local << D.child_shift) |
-                      resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
+        if (f.mode == RESOCT_MODE_RESIDENCY) {
+          // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
+          // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
+          // The LOD level changes rarely along a ray; a new slice/lens segment (cached_node
+          // reset) may change the bank and with it the channels' level ranges.
+          if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
+            cap_lod = lod;
+            uint cap_level = RESOCT_NONE_U;
+            uvec3 coarse_f = uvec3(0u);
+            for (uint c = 0u; c < n; ++c) {
+              if (((live >> c) & 1u) == 0u) continue;
+              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              uint lc = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              cap_level = min(cap_level, lc);
+              coarse_f = max(coarse_f, resoct_level_factor(resoct_read_level(lc)));
             }
-            if (d < f.start_depth) continue;
-            if (on_path && d <= reuse_end && path_local[d] == local) {
-              state = path_empty[d];
-              if (d == reuse_end && path_skip != 0u) {
+            if (cap_level == RESOCT_NONE_U) cap_level = lod;
+            cap_depth = min(trav_depth, resoct_level_depth_cap(
+                                            f.start_depth, f.depth_count,
+                                            resoct_level_factor(resoct_read_level(cap_level))));
+            margin = resoct_culling_margin(coarse_f);
+          }
+          // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
+          bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
+                           all(greaterThanEqual(cell, cached_lo)) && all(lessThan(cell, cached_hi));
+          if (!same_node) {
+            ResoctDepthInfo Dt = resoct_read_depth(cap_depth);
+            uvec3 trav_coord = resoct_node_coord(Dt, cell);
+            uvec3 trav_log2 = resoct_depth_count_log2(Dt);
+            uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
+            cached_lo = ivec3(trav_coord * ne);
+            cached_hi = cached_lo + ivec3(ne);
+            cached_coord = trav_coord;
+            // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
+            // node advances the channel index in the same node. `state` = channels empty so far
+            // (always channels 0 .. ci - 1). The descent restarts below the deepest node it
+            // shares with the previous descent's path (whose results depend only on that node and
+            // its ancestors), except for projection channels, whose class follows the running
+            // value along the ray.
+            uint reuse_end = cached_node == RESOCT_NONE_U ? RESOCT_NONE_U : path_end;
+            RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+              reuse_end = RESOCT_NONE_U;
+            }
+            bool on_path = reuse_end != RESOCT_NONE_U;
+            cached_depth = cap_depth;
+            cached_homog = 0u;
+            cached_skip_depth = RESOCT_NONE_U;
+            uint state = 0u;
+            uint local = 0u;
+            for (uint d = 0u; d <= cap_depth; ++d) {
+              ResoctDepthInfo D = resoct_read_depth(d);
+              if (d > 0u) {
+                local = (local << D.child_shift) |
+                        resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
+              }
+              if (d < f.start_depth) continue;
+              if (on_path && d <= reuse_end && path_local[d] == local) {
+                state = path_empty[d];
+                if (d == reuse_end && path_skip != 0u) {
+                  cached_skip_depth = d;
+                  break;
+                }
+                continue;
+              }
+              // From here on the path differs from the previous one: drop its deeper entries.
+              on_path = false;
+              path_local[d] = local;
+              path_end = d > f.start_depth ? d - 1u : RESOCT_NONE_U;
+              path_skip = 0u;
+              if (d == cap_depth) break;  // the traversal node: classified below
+              stats.nodes = stats.nodes + 1u;
+              uint nd = D.first_node + local;
+              uint ci = uint(bitCount(state));
+              while (ci < n) {
+                bool empty = ((live >> ci) & 1u) == 0u;
+                if (!empty) {
+                  uint cls;
+                  RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                    cls = resoct_mode_node_class_carried(nd, d, f.start_depth,
+                                                         resoct_read_slot(bank + ci),
+                                                         f.node_slot_count, fx.proj[ci]);
+                  }
+                  else {
+                    cls = resoct_node_class_carried(nd, d, f.start_depth, resoct_read_slot(bank + ci),
+                                                    f.node_slot_count);
+                  }
+                  empty = cls == RESOCT_NODE_CLASS_EMPTY;
+                }
+                if (!empty) break;
+                state = state | (1u << ci);
+                ci = ci + 1u;
+              }
+              path_empty[d] = state;
+              path_end = d;
+              path_skip = ci == n ? 1u : 0u;
+              if (ci == n) {
                 cached_skip_depth = d;
                 break;
               }
-              continue;
             }
-            // From here on the path differs from the previous one: drop its deeper entries.
-            on_path = false;
-            path_local[d] = local;
-            path_end = d > f.start_depth ? d - 1u : RESOCT_NONE_U;
-            path_skip = 0u;
-            if (d == cap_depth) break;  // the traversal node: classified below
-            stats.nodes = stats.nodes + 1u;
-            uint nd = D.first_node + local;
-            uint ci = uint(bitCount(state));
-            while (ci < n) {
-              bool empty = ((live >> ci) & 1u) == 0u;
-              if (!empty) {
+            cached_empty = state;
+            if (cached_skip_depth == RESOCT_NONE_U) {
+              // The remaining channels at the traversal node. A node whose own record is INVALID
+              // is requested; its class is carried down from the nearest ancestor with metadata
+              // (not empty when there is none).
+              cached_node = Dt.first_node + local;
+              stats.nodes = stats.nodes + 1u;
+              uint invalid = 0u;
+              for (uint c = uint(bitCount(state)); c < n; ++c) {
+                if (((live >> c) & 1u) == 0u) {
+                  cached_empty = cached_empty | (1u << c);
+                  continue;
+                }
+                ResoctSlotInfo sc = resoct_read_slot(bank + c);
                 uint cls;
                 RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                  cls = resoct_mode_node_class_carried(nd, d, f.start_depth,
-                                                       resoct_read_slot(bank + ci),
-                                                       f.node_slot_count, fx.proj[ci]);
+                  cls = resoct_mode_node_class(cached_node, sc, f.node_slot_count, fx.proj[c]);
                 }
                 else {
-                  cls = resoct_node_class_carried(nd, d, f.start_depth, resoct_read_slot(bank + ci),
-                                                  f.node_slot_count);
+                  cls = resoct_node_class(cached_node, sc, f.node_slot_count);
                 }
-                empty = cls == RESOCT_NODE_CLASS_EMPTY;
-              }
-              if (!empty) break;
-              state = state | (1u << ci);
-              ci = ci + 1u;
-            }
-            path_empty[d] = state;
-            path_end = d;
-            path_skip = ci == n ? 1u : 0u;
-            if (ci == n) {
-              cached_skip_depth = d;
-              break;
-            }
-          }
-          cached_empty = state;
-          if (cached_skip_depth == RESOCT_NONE_U) {
-            // The remaining channels at the traversal node. A node whose own record is INVALID
-            // is requested; its class is carried down from the nearest ancestor with metadata
-            // (not empty when there is none).
-            cached_node = Dt.first_node + local;
-            stats.nodes = stats.nodes + 1u;
-            uint invalid = 0u;
-            for (uint c = uint(bitCount(state)); c < n; ++c) {
-              if (((live >> c) & 1u) == 0u) {
-                cached_empty = cached_empty | (1u << c);
-                continue;
-              }
-              ResoctSlotInfo sc = resoct_read_slot(bank + c);
-              uint cls;
-              RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                cls = resoct_mode_node_class(cached_node, sc, f.node_slot_count, fx.proj[c]);
-              }
-              else {
-                cls = resoct_node_class(cached_node, sc, f.node_slot_count);
-              }
-              if (cls == RESOCT_NODE_CLASS_INVALID) {
-                invalid = invalid | (1u << c);
-                RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                  cls = resoct_mode_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
-                                                       f.node_slot_count, fx.proj[c]);
+                if (cls == RESOCT_NODE_CLASS_INVALID) {
+                  invalid = invalid | (1u << c);
+                  RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                    cls = resoct_mode_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
+                                                         f.node_slot_count, fx.proj[c]);
+                  }
+                  else {
+                    cls = resoct_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
+                                                    f.node_slot_count);
+                  }
+                  // A homogeneous ancestor's value is only known at the ancestor: read it there.
+                  if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
                 }
-                else {
-                  cls = resoct_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
-                                                  f.node_slot_count);
-                }
-                // A homogeneous ancestor's value is only known at the ancestor: read it there.
-                if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
+                if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
+                if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
               }
-              if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
-              if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
-            }
-            uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
-            if (cached_empty == all) {
-              cached_skip_depth = cap_depth;
-            } else if ((invalid >> uint(findLSB(~cached_empty))) != 0u &&
-                       cached_node != last_node_request) {
-              // Requested when an INVALID channel is at or after the first channel that is
-              // not empty here: channels before it were settled by their ancestors' records.
-              last_node_request = cached_node;
-              resoct_report_node_request(cached_node);
-              stats.requests = stats.requests + 1u;
-            }
-          } else {
-            ResoctDepthInfo Dk = resoct_read_depth(cached_skip_depth);
-            cached_node = Dk.first_node + path_local[cached_skip_depth];
-          }
-        }
-        uint node = cached_node;
-        if (cached_skip_depth != RESOCT_NONE_U) {
-          ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
-          uvec3 nc = resoct_node_coord(Ds, cell);
-          uvec3 ne = uvec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
-          skip = true;
-          skip_exit = resoct_box_exit(cell, frac, dir_vox, ivec3(nc * ne), vec3(ne));
-        } else {
-          for (uint c = 0u; c < n; ++c) {
-            if (((cached_empty >> c) & 1u) != 0u) continue;
-            ResoctSlotInfo s = resoct_read_slot(bank + c);
-            float value = 0.0f;
-            uint res = RESOCT_CH_NONE;
-            uint target = 0u;
-            if (((cached_homog >> c) & 1u) != 0u) {
-              uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
-                                         RESOCT_NODE_MINMAX);
-              value = float(resoct_node_min16(mm)) / 65535.0f;
-              res = RESOCT_CH_VALUE;
+              uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
+              if (cached_empty == all) {
+                cached_skip_depth = cap_depth;
+              } else if ((invalid >> uint(findLSB(~cached_empty))) != 0u &&
+                         cached_node != last_node_request) {
+                // Requested when an INVALID channel is at or after the first channel that is
+                // not empty here: channels before it were settled by their ancestors' records.
+                last_node_request = cached_node;
+                resoct_report_node_request(cached_node);
+                stats.requests = stats.requests + 1u;
+              }
             } else {
-              target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-              res = resoct_residency_channel(sp, s, node, target, cell, frac, last_key[c], value,
-                                             stats);
-            }
-            if (res == RESOCT_CH_VALUE) {
-              RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-                uint level = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-                RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-                  level = resoct_present_level(sp, s, node, level, cell);
-                }
-                fx_value[c] = value;
-                fx_level[c] = level;
-                fx_have = fx_have | (1u << c);
-              }
-              else {
-                vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
-                resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
-              }
-              any_value = true;
+              ResoctDepthInfo Dk = resoct_read_depth(cached_skip_depth);
+              cached_node = Dk.first_node + path_local[cached_skip_depth];
             }
           }
-        }
-      } else {
-        // Page-table and standard-octree modes: channels independently; skip only when every
-        // live channel is EMPTY, to the nearest EMPTY-brick exit.
-        bool all_empty = true;
-        for (uint c = 0u; c < n; ++c) {
-          if (((live >> c) & 1u) == 0u) continue;
-          ResoctSlotInfo s = resoct_read_slot(bank + c);
-          uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-          float value = 0.0f;
-          float exit_c = 0.0f;
-          uint res;
-          if (f.mode == RESOCT_MODE_OCTREE) {
-            res = resoct_octree_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
-                                        exit_c, stats);
+          uint node = cached_node;
+          // A node's class holds in the node shrunk by the margin (the whole node at level 0);
+          // in the rest of it every live channel is looked up, and entering the shrunk part
+          // starts a new segment.
+          bool use_class = true;
+          if (cached_skip_depth != RESOCT_NONE_U) {
+            ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
+            ivec3 ne = ivec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
+            ivec3 nlo = ivec3(resoct_node_coord(Ds, cell)) * ne;
+            ivec3 ilo = nlo + margin;
+            ivec3 ihi = nlo + ne - margin;
+            if (all(greaterThanEqual(cell, ilo)) && all(lessThan(cell, ihi))) {
+              skip = true;
+              skip_exit = resoct_box_exit(cell, frac, dir_vox, ilo, vec3(ihi - ilo));
+            } else {
+              use_class = false;
+              resoct_box_clip(seg_lo, seg_hi, nlo, nlo + ne);
+              ex_lo = ilo;
+              ex_hi = ihi;
+            }
           } else {
-            res = resoct_pagetable_channel(sp, s, target, cell, frac, dir_vox, last_key[c], value,
-                                           exit_c, stats);
-          }
-          if (res == RESOCT_CH_EMPTY) {
-            skip_exit = min(skip_exit, exit_c);
-          } else {
-            all_empty = false;
-          }
-          if (res == RESOCT_CH_VALUE) {
-            RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-              uint level = target;
-              RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-                if (f.mode == RESOCT_MODE_OCTREE) level = resoct_octree_level(sp, s, target, cell);
+            resoct_box_clip(seg_lo, seg_hi, cached_lo, cached_hi);
+            uint all_live = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
+            if (((cached_empty | cached_homog) & all_live) != 0u && any(greaterThan(margin, ivec3(0)))) {
+              ivec3 ilo = cached_lo + margin;
+              ivec3 ihi = cached_hi - margin;
+              if (all(greaterThanEqual(cell, ilo)) && all(lessThan(cell, ihi))) {
+                resoct_box_clip(seg_lo, seg_hi, ilo, ihi);
+              } else {
+                use_class = false;
+                ex_lo = ilo;
+                ex_hi = ihi;
               }
-              fx_value[c] = value;
-              fx_level[c] = level;
-              fx_have = fx_have | (1u << c);
             }
-            else {
-              vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
-              resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
-            }
-            any_value = true;
           }
+          seg_node = node;
+          if (!skip) {
+            ivec3 node_lo = seg_lo;
+            ivec3 node_hi = seg_hi;
+            for (uint c = 0u; c < n; ++c) {
+              if (((live >> c) & 1u) == 0u) continue;
+              if (use_class && ((cached_empty >> c) & 1u) != 0u) continue;
+              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              if (use_class && ((cached_homog >> c) & 1u) != 0u) {
+                uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
+                                           RESOCT_NODE_MINMAX);
+                src[c] = resoct_source_of(RESOCT_CH_VALUE, float(resoct_node_min16(mm)) / 65535.0f);
+              } else {
+                uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+                src[c] = resoct_residency_source(sp, s, node, node_lo, node_hi, target, cell,
+                                                 last_key[c], seg_lo, seg_hi, stats);
+              }
+            }
+          }
+        } else {
+          // Page-table and standard-octree modes: channels independently; skip only when every
+          // live channel is EMPTY, to the nearest EMPTY-brick exit.
+          bool all_empty = true;
+          for (uint c = 0u; c < n; ++c) {
+            if (((live >> c) & 1u) == 0u) continue;
+            ResoctSlotInfo s = resoct_read_slot(bank + c);
+            uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+            float exit_c = 0.0f;
+            if (f.mode == RESOCT_MODE_OCTREE) {
+              src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                                            seg_lo, seg_hi, exit_c, stats);
+            } else {
+              src[c] = resoct_pagetable_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                                               seg_lo, seg_hi, exit_c, stats);
+            }
+            if (src[c].kind == RESOCT_CH_EMPTY) {
+              skip_exit = min(skip_exit, exit_c);
+            } else {
+              all_empty = false;
+            }
+          }
+          skip = all_empty;
         }
-        skip = all_empty;
+        if (skip) have_seg = false;
       }
 
-      RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-        for (uint c = 0u; c < n; ++c) {
-          if (((fx_have >> c) & 1u) == 0u) continue;
-          RESOCT_FX(resoct_fx_channel)
-          (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], lod, seg, tm, cell,
-           frac, fx, pr, weighted, combined, acc, stats);
+      bool any_value = false;
+      vec4 weighted;
+      float combined;
+      resoct_mix_begin(weighted, combined);
+      if (!skip) {
+        RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+          acc = resoct_preint_begin_sample(pr, seg_lod, seg / f.ref_step, acc);
         }
-      }
-      RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-        acc = resoct_preint_end_sample(pr, acc);
+        // Effects: the channels' values are collected and handled by one call below, so the GPU
+        // compiler inlines the effect code once, not once per render mode.
+        float fx_value[RESOCT_MAX_SLOTS];
+        uint fx_level[RESOCT_MAX_SLOTS];
+        uint fx_have = 0u;
+        for (uint c = 0u; c < n; ++c) {
+          if (src[c].kind != RESOCT_CH_VALUE) continue;
+          ResoctSlotInfo s = resoct_read_slot(bank + c);
+          float value;
+          resoct_source_sample(sp, s, src[c], cell, frac, value, stats);
+          RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+            uint level = resoct_channel_level(seg_lod, s.finest_level, s.coarsest_level);
+            RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
+              if (f.mode == RESOCT_MODE_RESIDENCY) {
+                level = resoct_present_level(sp, s, seg_node, level, cell);
+              } else if (f.mode == RESOCT_MODE_OCTREE) {
+                level = resoct_octree_level(sp, s, level, cell);
+              }
+            }
+            fx_value[c] = value;
+            fx_level[c] = level;
+            fx_have = fx_have | (1u << c);
+          }
+          else {
+            vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
+            resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
+          }
+          any_value = true;
+        }
+
+        RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+          for (uint c = 0u; c < n; ++c) {
+            if (((fx_have >> c) & 1u) == 0u) continue;
+            RESOCT_FX(resoct_fx_channel)
+            (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], seg_lod, seg,
+             tm, cell, frac, fx, pr, weighted, combined, acc, stats);
+          }
+        }
+        RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+          acc = resoct_preint_end_sample(pr, acc);
+        }
+      } else {
+        RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+          acc = resoct_preint_begin_sample(pr, seg_lod, seg / f.ref_step, acc);
+          acc = resoct_preint_end_sample(pr, acc);
+        }
       }
 
       if (any_value) {
@@ -475,6 +539,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                                 bank, cached_node, cached_coord, stats)) {
       break;
     }
+    have_seg = false;
   }
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     acc = resoct_fx_projection_composite(fx, n, live_anywhere, t_exit - t_enter, acc);
