@@ -15,8 +15,7 @@
 
 namespace resoct::cpu::detail {
 
-__attribute__((visibility("hidden"))) KernelContext g_ctx;
-std::mutex g_render_mutex;
+__thread const KernelContext* t_ctx = nullptr;
 
 }  // namespace resoct::cpu::detail
 
@@ -153,9 +152,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   const auto start = std::chrono::steady_clock::now();
   check_tables(tables);
   const kernel::ResoctFrame frame = tables.frame;
-  std::lock_guard lock(detail::g_render_mutex);
-
-  detail::KernelContext& c = detail::g_ctx;
+  detail::KernelContext c;
   c.nodes = nodes_.data();
   c.pages = pages_.data();
   c.directory = directory_.data();
@@ -184,10 +181,10 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   const std::uint32_t fx = mask & kernel::RESOCT_EFFECT_ANY;
   const bool preint = (mask & kernel::RESOCT_EFFECT_PREINT) != 0u;
   const detail::RayTotals r =
-      fx == 0u ? (preint ? detail::render_preint(frame, pixels, threads)
-                         : detail::render_plain(frame, pixels, threads))
-               : (preint ? detail::render_effects_preint(fx, frame, pixels, threads)
-                         : detail::render_effects(fx, frame, pixels, threads));
+      fx == 0u ? (preint ? detail::render_preint(c, frame, pixels, threads)
+                         : detail::render_plain(c, frame, pixels, threads))
+               : (preint ? detail::render_effects_preint(fx, c, frame, pixels, threads)
+                         : detail::render_effects(fx, c, frame, pixels, threads));
 
   BackendStats& s = result.stats;
   s = BackendStats{};

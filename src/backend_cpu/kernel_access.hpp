@@ -1,6 +1,7 @@
 #pragma once
-// Internal to resoct::cpu: the kernel's accessors over one process-wide context (set by
-// CpuBackend::render under a mutex) and the tile loop of one frame, specialized per effect mask.
+// Internal to resoct::cpu: the kernel's accessors over the rendering backend's context (one per
+// render() call, reached through a thread-local pointer that each render thread sets) and the
+// tile loop of one frame, specialized per effect mask.
 // The mask-0 (plain) instantiation and the effect instantiations live in separate translation
 // units (render_plain.cpp, render_effects.cpp) so that the compiler's unit-wide inlining budget
 // spent on sixteen kernel copies cannot change how the plain kernel is optimized. The same
@@ -21,9 +22,8 @@
 
 namespace resoct::cpu::detail {
 
-// Everything the kernel's accessors read during one render(). One process-wide instance, set
-// under g_render_mutex: a plain global costs nothing per access, unlike a thread_local in a
-// shared library.
+// Everything the kernel's accessors read during one render(), built by CpuBackend::render on its
+// stack, so that backends in one process render at the same time.
 struct KernelContext {
   const std::uint32_t* nodes = nullptr;
   const std::uint32_t* pages = nullptr;  // the page pool
@@ -44,8 +44,11 @@ struct KernelContext {
   std::atomic<std::uint64_t>* used = nullptr;
 };
 
-// Hidden: the kernel TUs reach it PC-relative, not through the GOT of the shared library.
-extern KernelContext g_ctx __attribute__((visibility("hidden")));
+// The context of the render this thread works for. `__thread` (no dynamic initialization, so no
+// TLS wrapper call) with the initial-exec model: an access is one %fs-relative load, not a
+// __tls_get_addr call as the default model of a shared library would make it.
+extern __thread const KernelContext* t_ctx
+    __attribute__((visibility("hidden"), tls_model("initial-exec")));
 
 template <class T>
 inline float load_voxel(const std::byte* base, std::size_t i) {
@@ -98,40 +101,40 @@ template <class T>
 namespace resoct::kernel {
 
 inline uint resoct_read_node(uint index) {
-  return cpu::detail::g_ctx.nodes[index];
+  return cpu::detail::t_ctx->nodes[index];
 }
 inline uint resoct_read_page(uint index) {
-  return cpu::detail::g_ctx.pages[index];
+  return cpu::detail::t_ctx->pages[index];
 }
 inline uint resoct_read_directory(uint index) {
-  return cpu::detail::g_ctx.directory[index];
+  return cpu::detail::t_ctx->directory[index];
 }
 inline uint resoct_read_directory_offset(uint table) {
-  return cpu::detail::g_ctx.directory_offsets[table];
+  return cpu::detail::t_ctx->directory_offsets[table];
 }
 inline ResoctSlotInfo resoct_read_slot(uint i) {
-  return cpu::detail::g_ctx.slots[i];
+  return cpu::detail::t_ctx->slots[i];
 }
 inline ResoctLevelInfo resoct_read_level(uint l) {
-  return cpu::detail::g_ctx.levels[l];
+  return cpu::detail::t_ctx->levels[l];
 }
 inline ResoctDepthInfo resoct_read_depth(uint d) {
-  return cpu::detail::g_ctx.depths[d];
+  return cpu::detail::t_ctx->depths[d];
 }
 inline vec4 resoct_read_tf(uint slot, uint index) {
-  return cpu::detail::g_ctx.tf[std::size_t(slot) * 1024u + index];
+  return cpu::detail::t_ctx->tf[std::size_t(slot) * 1024u + index];
 }
 inline vec4 resoct_read_preint(uint slot, uint index) {
-  return cpu::detail::g_ctx.preint[std::size_t(slot) * 2048u + index];
+  return cpu::detail::t_ctx->preint[std::size_t(slot) * 2048u + index];
 }
 inline ResoctFxFrame resoct_read_fx_frame() {
-  return *cpu::detail::g_ctx.fx;
+  return *cpu::detail::t_ctx->fx;
 }
 inline float resoct_read_level_size_log2(uint level) {
-  return cpu::detail::g_ctx.levels[level].size_log2;
+  return cpu::detail::t_ctx->levels[level].size_log2;
 }
 inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
-  const auto& c = cpu::detail::g_ctx;
+  const auto& c = *cpu::detail::t_ctx;
   const std::byte* brick = c.cache + std::size_t(cache_slot) * c.slot_voxels * voxel_size(c.type);
   switch (c.type) {
     case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.padded, pos);
@@ -141,13 +144,13 @@ inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
   return 0.0f;
 }
 inline void resoct_report_request(uint device_key) {
-  cpu::detail::g_ctx.brick_requests->insert(device_key);
+  cpu::detail::t_ctx->brick_requests->insert(device_key);
 }
 inline void resoct_report_node_request(uint node) {
-  cpu::detail::g_ctx.node_requests->insert(node);
+  cpu::detail::t_ctx->node_requests->insert(node);
 }
 inline void resoct_mark_used(uint cache_slot) {
-  std::atomic<std::uint64_t>& w = cpu::detail::g_ctx.used[cache_slot >> 6u];
+  std::atomic<std::uint64_t>& w = cpu::detail::t_ctx->used[cache_slot >> 6u];
   const std::uint64_t bit = std::uint64_t(1) << (cache_slot & 63u);
   // Read first: almost every call finds the bit set, and a read shares the cache line.
   if ((w.load(std::memory_order_relaxed) & bit) == 0) w.fetch_or(bit, std::memory_order_relaxed);
@@ -185,7 +188,8 @@ template <std::uint32_t EFFECTS>
 // All tiles of one frame with the kernel specialized for the effect mask EFFECTS: the mask is
 // chosen once per frame (render()), so no sample ever branches on it at run time.
 template <std::uint32_t EFFECTS>
-RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
+RayTotals render_tiles(const KernelContext& ctx, const kernel::ResoctFrame& frame,
+                       glm::vec4* pixels, int threads) {
   const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
   const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
   const std::int64_t tile_count = std::int64_t(tiles_x) * tiles_y;
@@ -194,55 +198,62 @@ RayTotals render_tiles(const kernel::ResoctFrame& frame, glm::vec4* pixels, int 
   double skipped = 0.0, marched = 0.0;
   // Row-major tile order with dynamic scheduling: neighbouring tiles (coherent rays) run close
   // in time, and uneven tiles (empty vs. dense) balance.
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)                         \
+#pragma omp parallel num_threads(threads)                                                    \
     reduction(+ : samples, nodes, accesses, iterations, caps, requests, skipped, marched, \
                   gradients, shadow_rays)
-  for (std::int64_t tile = 0; tile < tile_count; ++tile) {
-    const std::uint32_t tx = std::uint32_t(tile % tiles_x) * kTile;
-    const std::uint32_t ty = std::uint32_t(tile / tiles_x) * kTile;
-    const std::uint32_t x1 = std::min(tx + kTile, frame.width);
-    const std::uint32_t y1 = std::min(ty + kTile, frame.height);
-    for (std::uint32_t y = ty; y < y1; ++y) {
-      for (std::uint32_t x = tx; x < x1; ++x) {
-        kernel::ResoctRayStats st{};
-        glm::vec4 p;
-        if constexpr ((EFFECTS & kernel::RESOCT_EFFECT_ANY) == 0u) {
-          p = resoct_render_pixel_plain<EFFECTS>(frame, x, y, st);
-        } else {
-          p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
-        }
-        // The image holds straight alpha (docs/rendering.md "Compositing").
-        pixels[std::size_t(y) * frame.width + x] =
-            p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
-        samples += st.samples;
-        nodes += st.nodes;
-        accesses += st.brick_accesses;
-        iterations += st.iterations;
-        caps += st.cap_hits;
-        requests += st.requests;
-        skipped += double(st.skipped);
-        marched += double(st.marched);
-        if constexpr (EFFECTS != 0u) {
-          gradients += st.gradient_evals;
-          shadow_rays += st.shadow_rays;
+  {
+    t_ctx = &ctx;
+#pragma omp for schedule(dynamic, 1)
+    for (std::int64_t tile = 0; tile < tile_count; ++tile) {
+      const std::uint32_t tx = std::uint32_t(tile % tiles_x) * kTile;
+      const std::uint32_t ty = std::uint32_t(tile / tiles_x) * kTile;
+      const std::uint32_t x1 = std::min(tx + kTile, frame.width);
+      const std::uint32_t y1 = std::min(ty + kTile, frame.height);
+      for (std::uint32_t y = ty; y < y1; ++y) {
+        for (std::uint32_t x = tx; x < x1; ++x) {
+          kernel::ResoctRayStats st{};
+          glm::vec4 p;
+          if constexpr ((EFFECTS & kernel::RESOCT_EFFECT_ANY) == 0u) {
+            p = resoct_render_pixel_plain<EFFECTS>(frame, x, y, st);
+          } else {
+            p = kernel::resoct_render_pixel_fx<EFFECTS>(frame, x, y, st);
+          }
+          // The image holds straight alpha (docs/rendering.md "Compositing").
+          pixels[std::size_t(y) * frame.width + x] =
+              p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
+          samples += st.samples;
+          nodes += st.nodes;
+          accesses += st.brick_accesses;
+          iterations += st.iterations;
+          caps += st.cap_hits;
+          requests += st.requests;
+          skipped += double(st.skipped);
+          marched += double(st.marched);
+          if constexpr (EFFECTS != 0u) {
+            gradients += st.gradient_evals;
+            shadow_rays += st.shadow_rays;
+          }
         }
       }
     }
+    t_ctx = nullptr;
   }
   return {samples,  nodes,     accesses,    iterations, caps,
           requests, gradients, shadow_rays, skipped,    marched};
 }
 
 /// The plain kernel (render_plain.cpp).
-RayTotals render_plain(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
+RayTotals render_plain(const KernelContext& ctx, const kernel::ResoctFrame& frame,
+                       glm::vec4* pixels, int threads);
 /// The plain kernel with pre-integration, mask RESOCT_EFFECT_PREINT (render_preint.cpp).
-RayTotals render_preint(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
+RayTotals render_preint(const KernelContext& ctx, const kernel::ResoctFrame& frame,
+                        glm::vec4* pixels, int threads);
 /// The kernel specialized for `mask` (1 .. 15; render_effects.cpp).
-RayTotals render_effects(std::uint32_t mask, const kernel::ResoctFrame& frame, glm::vec4* pixels,
-                         int threads);
+RayTotals render_effects(std::uint32_t mask, const KernelContext& ctx,
+                         const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
 /// The kernel specialized for `mask` (17 .. 31: effects with pre-integration;
 /// render_effects_preint.cpp).
-RayTotals render_effects_preint(std::uint32_t mask, const kernel::ResoctFrame& frame,
-                                glm::vec4* pixels, int threads);
+RayTotals render_effects_preint(std::uint32_t mask, const KernelContext& ctx,
+                                const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads);
 
 }  // namespace resoct::cpu::detail

@@ -8,7 +8,8 @@
 namespace resoct::cpu::detail {
 namespace {
 
-using TileRenderer = RayTotals (*)(const kernel::ResoctFrame&, glm::vec4*, int);
+using TileRenderer = RayTotals (*)(const KernelContext&, const kernel::ResoctFrame&, glm::vec4*,
+                                   int);
 
 template <std::uint32_t... Masks>
 constexpr std::array<TileRenderer, sizeof...(Masks)> make_renderers(
@@ -22,9 +23,9 @@ constexpr auto kRenderers =
 
 }  // namespace
 
-RayTotals render_effects(std::uint32_t mask, const kernel::ResoctFrame& frame, glm::vec4* pixels,
-                         int threads) {
-  return kRenderers[mask % kernel::RESOCT_EFFECT_PREINT](frame, pixels, threads);
+RayTotals render_effects(std::uint32_t mask, const KernelContext& ctx,
+                         const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
+  return kRenderers[mask % kernel::RESOCT_EFFECT_PREINT](ctx, frame, pixels, threads);
 }
 
 }  // namespace resoct::cpu::detail

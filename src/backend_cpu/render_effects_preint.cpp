@@ -9,7 +9,8 @@
 namespace resoct::cpu::detail {
 namespace {
 
-using TileRenderer = RayTotals (*)(const kernel::ResoctFrame&, glm::vec4*, int);
+using TileRenderer = RayTotals (*)(const KernelContext&, const kernel::ResoctFrame&, glm::vec4*,
+                                   int);
 
 template <std::uint32_t... Masks>
 constexpr std::array<TileRenderer, sizeof...(Masks)> make_renderers(
@@ -23,9 +24,9 @@ constexpr auto kRenderers =
 
 }  // namespace
 
-RayTotals render_effects_preint(std::uint32_t mask, const kernel::ResoctFrame& frame,
-                                glm::vec4* pixels, int threads) {
-  return kRenderers[mask % kernel::RESOCT_EFFECT_PREINT](frame, pixels, threads);
+RayTotals render_effects_preint(std::uint32_t mask, const KernelContext& ctx,
+                                const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
+  return kRenderers[mask % kernel::RESOCT_EFFECT_PREINT](ctx, frame, pixels, threads);
 }
 
 }  // namespace resoct::cpu::detail

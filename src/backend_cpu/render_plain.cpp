@@ -3,8 +3,9 @@
 
 namespace resoct::cpu::detail {
 
-RayTotals render_plain(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
-  return render_tiles<0u>(frame, pixels, threads);
+RayTotals render_plain(const KernelContext& ctx, const kernel::ResoctFrame& frame,
+                       glm::vec4* pixels, int threads) {
+  return render_tiles<0u>(ctx, frame, pixels, threads);
 }
 
 }  // namespace resoct::cpu::detail

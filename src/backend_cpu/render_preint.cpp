@@ -4,8 +4,9 @@
 
 namespace resoct::cpu::detail {
 
-RayTotals render_preint(const kernel::ResoctFrame& frame, glm::vec4* pixels, int threads) {
-  return render_tiles<kernel::RESOCT_EFFECT_PREINT>(frame, pixels, threads);
+RayTotals render_preint(const KernelContext& ctx, const kernel::ResoctFrame& frame,
+                        glm::vec4* pixels, int threads) {
+  return render_tiles<kernel::RESOCT_EFFECT_PREINT>(ctx, frame, pixels, threads);
 }
 
 }  // namespace resoct::cpu::detail

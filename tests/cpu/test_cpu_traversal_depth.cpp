@@ -126,8 +126,8 @@ std::uint32_t depth_with_nodes_of(const OctreeLayout& layout, glm::u64vec3 need)
 // All channels sample level 2 or coarser and steps are about a level-0 voxel: without the cap the
 // traversal would descend to the 2³ leaves. Capped, it stops at nodes of two level-2 voxels (8³,
 // one trilinear footprint of the sampled level): at most cap + 1 nodes per position, and the same
-// samples, brick reads and image as a render that classifies those nodes without a descent
-// (start_depth = cap).
+// image as a render that classifies those nodes without a descent (start_depth = cap), from no
+// more samples.
 TEST(CpuTraversalDepth, CoarseLevelsCapTheDepth) {
   ProceduralSource src("procedural:tubes:64x64x64", bricks8());
   ResidentOptions ro;
@@ -151,8 +151,11 @@ TEST(CpuTraversalDepth, CoarseLevelsCapTheDepth) {
     o.start_depth = cap;
     const Rendered flat = render_cpu(rs, s, o);
     ASSERT_GT(res.stats.samples, 0u);
-    EXPECT_EQ(res.stats.samples, flat.stats.samples) << view;
-    EXPECT_EQ(res.stats.brick_accesses, flat.stats.brick_accesses) << view;
+    // At level 2 a node's culling holds in the node shrunk by half a level voxel (exact culling,
+    // docs/rendering.md): skipping a large empty ancestor skips every sample that skipping its
+    // capped descendants would, and the rims inside it too.
+    EXPECT_LE(res.stats.samples, flat.stats.samples) << view;
+    EXPECT_EQ(res.stats.samples, res.stats.brick_accesses) << view;
     EXPECT_LT(max_diff(res.image, flat.image), 1e-4) << view;
     EXPECT_LE(res.stats.nodes_visited, res.stats.iterations * (cap + 1))
         << view << ": " << res.stats.nodes_visited << " nodes, " << res.stats.iterations

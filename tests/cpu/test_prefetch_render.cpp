@@ -85,7 +85,10 @@ TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
 TEST(PrefetchRender, ChangesNoImageAndServesLaterRequests) {
   std::shared_ptr<const BrickSource> src =
       make_procedural_source("procedural:tubes:64x64x64", BrickLayout{glm::uvec3(8), 1});
-  const Scene base = tubes_scene(24);
+  // A narrow view that shows part of the volume, so that turning reveals bricks the current
+  // view does not demand yet.
+  Scene base = tubes_scene(24);
+  base.camera.fov_deg = 12.0;
   RendererOptions plain = sync_options();
   plain.upload_budget.max_bricks = 6;  // several frames per pose: the path outruns the loads
   RendererOptions ahead = plain;
@@ -93,7 +96,7 @@ TEST(PrefetchRender, ChangesNoImageAndServesLaterRequests) {
   ahead.prefetch.max_bricks = 16;
   Renderer a(src, plain), b(src, ahead);
   std::uint64_t queued = 0;
-  for (int f = 0; f < 10; ++f) {
+  for (int f = 0; f < 24; ++f) {
     Scene s = base;
     s.camera = orbit(base.camera, 6.0 * f);
     const FrameReport ra = a.render_frame(s);

@@ -134,10 +134,10 @@ RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSlotInfo s, Reso
   value = src.value;
   if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
   st.brick_accesses = st.brick_accesses + 1u;
-  float raw = resoct_sample_cache(
-      src.cache_slot, resoct_padded_position(resoct_read_level(src.level),
-                                             resoct_frame_brick_size(f), f.halo, src.brick, cell,
-                                             frac));
+  float raw =
+      resoct_sample_cache(src.cache_slot, resoct_padded_position(resoct_read_level(src.level),
+                                                                 resoct_frame_brick_size(f), f.halo,
+                                                                 src.brick, cell, frac));
   value = resoct_normalize_value(raw, s.range_lo, s.inv_range_width);
   return RESOCT_CH_VALUE;
 }
@@ -226,7 +226,8 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
                                         RESOCT_INOUT(ResoctRayStats) st) {
   ivec3 lo = cell;
   ivec3 hi = cell + ivec3(1);
-  ResoctSource src = resoct_residency_source(f, s, node, lo, hi, target, cell, last_key, lo, hi, st);
+  ResoctSource src =
+      resoct_residency_source(f, s, node, lo, hi, target, cell, last_key, lo, hi, st);
   return resoct_source_sample(f, s, src, cell, frac, value, st);
 }
 
@@ -234,9 +235,8 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
 /// the target brick. `skip_exit` receives the exit offset of an EMPTY brick.
 RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
                                                ivec3 cell, vec3 frac, vec3 dir_vox,
-                                               RESOCT_INOUT(uint) last_key,
-                                               RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
-                                               RESOCT_OUT(float) skip_exit,
+                                               RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
+                                               RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
                                                RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);

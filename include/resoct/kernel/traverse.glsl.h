@@ -303,8 +303,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                                                          f.node_slot_count, fx.proj[ci]);
                   }
                   else {
-                    cls = resoct_node_class_carried(nd, d, f.start_depth, resoct_read_slot(bank + ci),
-                                                    f.node_slot_count);
+                    cls = resoct_node_class_carried(nd, d, f.start_depth,
+                                                    resoct_read_slot(bank + ci), f.node_slot_count);
                   }
                   empty = cls == RESOCT_NODE_CLASS_EMPTY;
                 }
@@ -396,7 +396,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           } else {
             resoct_box_clip(seg_lo, seg_hi, cached_lo, cached_hi);
             uint all_live = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
-            if (((cached_empty | cached_homog) & all_live) != 0u && any(greaterThan(margin, ivec3(0)))) {
+            if (((cached_empty | cached_homog) & all_live) != 0u &&
+                any(greaterThan(margin, ivec3(0)))) {
               ivec3 ilo = cached_lo + margin;
               ivec3 ihi = cached_hi - margin;
               if (all(greaterThanEqual(cell, ilo)) && all(lessThan(cell, ihi))) {
@@ -437,8 +438,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
             float exit_c = 0.0f;
             if (f.mode == RESOCT_MODE_OCTREE) {
-              src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c],
-                                            seg_lo, seg_hi, exit_c, stats);
+              src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c], seg_lo,
+                                            seg_hi, exit_c, stats);
             } else {
               src[c] = resoct_pagetable_source(sp, s, target, cell, frac, dir_vox, last_key[c],
                                                seg_lo, seg_hi, exit_c, stats);
@@ -496,8 +497,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           for (uint c = 0u; c < n; ++c) {
             if (((fx_have >> c) & 1u) == 0u) continue;
             RESOCT_FX(resoct_fx_channel)
-            (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], seg_lod, seg,
-             tm, cell, frac, fx, pr, weighted, combined, acc, stats);
+            (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], seg_lod, seg, tm,
+             cell, frac, fx, pr, weighted, combined, acc, stats);
           }
         }
         RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
