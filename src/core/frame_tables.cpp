@@ -366,6 +366,9 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     D.node_extent_x = check_extent(od.node_extent.x, "layout");
     D.node_extent_y = check_extent(od.node_extent.y, "layout");
     D.node_extent_z = check_extent(od.node_extent.z, "layout");
+    D.count_log2_x = od.count_log2.x;
+    D.count_log2_y = od.count_log2.y;
+    D.count_log2_z = od.count_log2.z;
     out.depths.push_back(D);
   }
 }

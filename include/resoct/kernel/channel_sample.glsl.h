@@ -62,6 +62,21 @@ RESOCT_FN float resoct_box_exit(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, v
   return resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), dir_vox, size).y;
 }
 
+/// Offset of t from the position at which the ray leaves the integer box [lo, hi) (which holds
+/// the position); sizes are taken as unsigned differences, so an unclipped axis (+-2^31) is fine.
+RESOCT_FN float resoct_box_exit_t(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, ivec3 hi) {
+  return resoct_box_exit(cell, frac, dir_vox, lo, vec3(uvec3(hi) - uvec3(lo)));
+}
+
+/// Offset of t from the position at which the ray enters the integer box [lo, hi) ahead of it;
+/// infinite when it never does, 0 when the position is already inside.
+RESOCT_FN float resoct_box_entry_t(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, ivec3 hi) {
+  vec2 ie = resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), dir_vox,
+                                  vec3(uvec3(hi) - uvec3(lo)));
+  if (!(ie.x < ie.y) || !(ie.y > 0.0f)) return RESOCT_RAY_T_INF;
+  return max(ie.x, 0.0f);
+}
+
 /// Whether an EMPTY page entry renders: a brick of zeros where the transfer function shows 0
 /// (ResoctSlotInfo.zero_visible). A brick without finite values never does.
 RESOCT_FN bool resoct_empty_page_shows(ResoctSlotInfo s, uint entry) {
@@ -78,6 +93,17 @@ struct ResoctSource {
   uint cache_slot;  // mapped brick's cache slot, or RESOCT_SOURCE_NO_SLOT
   uint level;       // level of the brick sampled
   uvec3 brick;      // brick coordinates at that level
+  // Per-segment constants of the sample path, so that a sample reads no table: the padded-brick
+  // position of level-0 position (cell, frac) is (cell - core_lo + frac) * scale + halo.
+  ivec3 core_lo;  // level-0 corner of the brick's core
+  vec3 scale;     // 2^-factor_log2 per axis
+  uint tf_slot;   // transfer-function slot (ResoctSlotInfo.slot)
+  float range_lo;
+  float inv_range_width;
+  // Along the march (resoct_source_along_ray): the padded-brick position at ray parameter t is
+  // ray_base + t * ray_dir, so a sample computes no cell, fraction or floor.
+  vec3 ray_base;
+  vec3 ray_dir;
 };
 
 RESOCT_CONST(uint, RESOCT_SOURCE_NO_SLOT, 0xFFFFFFFFu);
@@ -89,7 +115,29 @@ RESOCT_FN ResoctSource resoct_source_of(uint kind, float value) {
   src.cache_slot = RESOCT_SOURCE_NO_SLOT;
   src.level = 0u;
   src.brick = uvec3(0u);
+  src.core_lo = ivec3(0);
+  src.scale = vec3(1.0f);
+  src.tf_slot = 0u;
+  src.range_lo = 0.0f;
+  src.inv_range_width = 1.0f;
+  src.ray_base = vec3(0.0f);
+  src.ray_dir = vec3(0.0f);
   return src;
+}
+
+/// A constant source of slot `s`.
+RESOCT_FN ResoctSource resoct_source_value(ResoctSlotInfo s, float value) {
+  ResoctSource src = resoct_source_of(RESOCT_CH_VALUE, value);
+  src.tf_slot = s.slot;
+  return src;
+}
+
+/// Whether the cell lies in the integer box [lo, hi) (unsigned differences: two operations per
+/// axis, no overflow for boxes spanning the whole int range).
+RESOCT_FN bool resoct_in_box(ivec3 cell, ivec3 lo, ivec3 hi) {
+  return uint(cell.x) - uint(lo.x) < uint(hi.x) - uint(lo.x) &&
+         uint(cell.y) - uint(lo.y) < uint(hi.y) - uint(lo.y) &&
+         uint(cell.z) - uint(lo.z) < uint(hi.z) - uint(lo.z);
 }
 
 /// Shrinks the integer box [lo, hi) to its intersection with [blo, bhi).
@@ -108,37 +156,62 @@ RESOCT_FN void resoct_box_clip_brick(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3)
 
 /// The source of a present (not UNMAPPED) page entry of `level`; marks a mapped brick's cache
 /// slot used (once per segment).
-RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint level, uvec3 brick) {
+RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint level,
+                                           ResoctLevelInfo L, uvec3 brick_size, uvec3 brick) {
   uint state = resoct_page_state(entry);
   if (state == RESOCT_PAGE_STATE_EMPTY) {
     if (!resoct_empty_page_shows(s, entry)) return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
-    return resoct_source_of(RESOCT_CH_VALUE, s.zero_value);
+    return resoct_source_value(s, s.zero_value);
   }
   if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
-    return resoct_source_of(RESOCT_CH_VALUE, resoct_page_homogeneous_value(entry));
+    return resoct_source_value(s, resoct_page_homogeneous_value(entry));
   }
   if (state != RESOCT_PAGE_STATE_MAPPED) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
-  ResoctSource src = resoct_source_of(RESOCT_CH_VALUE, 0.0f);
+  ResoctSource src = resoct_source_value(s, 0.0f);
   src.cache_slot = resoct_page_cache_slot(entry);
   src.level = level;
   src.brick = brick;
+  uvec3 fl = resoct_level_factor(L);
+  src.core_lo = resoct_brick_lo0(L, brick_size, brick);
+  src.scale = vec3(1.0f / float(1u << fl.x), 1.0f / float(1u << fl.y), 1.0f / float(1u << fl.z));
+  src.range_lo = s.range_lo;
+  src.inv_range_width = s.inv_range_width;
   resoct_mark_used(src.cache_slot);
   return src;
 }
 
 /// The value of a source at a level-0 position inside its segment: RESOCT_CH_VALUE with `value`
 /// (a trilinear sample of a mapped brick through its halo, or the constant), else the kind.
-RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSlotInfo s, ResoctSource src,
-                                    ivec3 cell, vec3 frac, RESOCT_OUT(float) value,
-                                    RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSource src, ivec3 cell, vec3 frac,
+                                    RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
   value = src.value;
   if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
   st.brick_accesses = st.brick_accesses + 1u;
-  float raw =
-      resoct_sample_cache(src.cache_slot, resoct_padded_position(resoct_read_level(src.level),
-                                                                 resoct_frame_brick_size(f), f.halo,
-                                                                 src.brick, cell, frac));
-  value = resoct_normalize_value(raw, s.range_lo, s.inv_range_width);
+  vec3 padded = (vec3(cell - src.core_lo) + frac) * src.scale + vec3(float(f.halo));
+  value = resoct_normalize_value(resoct_sample_cache(src.cache_slot, padded), src.range_lo,
+                                 src.inv_range_width);
+  return RESOCT_CH_VALUE;
+}
+
+/// Prepares a mapped source for resoct_source_sample_t along the ray origin_cell + origin_frac +
+/// t * dir_vox: the padded position is affine in t. The integer part of the offset from the brick
+/// is exact, so rounding is relative to the distance from the ray origin, as for positions.
+RESOCT_FN ResoctSource resoct_source_along_ray(ResoctSource src, ivec3 origin_cell,
+                                               vec3 origin_frac, vec3 dir_vox, uint halo) {
+  src.ray_base = (vec3(origin_cell - src.core_lo) + origin_frac) * src.scale + vec3(float(halo));
+  src.ray_dir = dir_vox * src.scale;
+  return src;
+}
+
+/// resoct_source_sample at ray parameter t, after resoct_source_along_ray.
+RESOCT_FN uint resoct_source_sample_t(ResoctSource src, float t, RESOCT_OUT(float) value,
+                                      RESOCT_INOUT(ResoctRayStats) st) {
+  value = src.value;
+  if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
+  st.brick_accesses = st.brick_accesses + 1u;
+  value =
+      resoct_normalize_value(resoct_sample_cache(src.cache_slot, src.ray_base + t * src.ray_dir),
+                             src.range_lo, src.inv_range_width);
   return RESOCT_CH_VALUE;
 }
 
@@ -185,7 +258,7 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
   resoct_box_clip_brick(lo, hi, L, bs, b);
   uint e = resoct_page_entry_of(s.slot, target, f.level_count, L, b);
   if (resoct_page_state(e) != RESOCT_PAGE_STATE_UNMAPPED) {
-    return resoct_entry_source(s, e, target, b);
+    return resoct_entry_source(s, e, target, L, bs, b);
   }
   resoct_request_missing(f, s, target, cell, last_key, st);
   resoct_box_clip(lo, hi, node_lo, node_hi);
@@ -200,7 +273,7 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
     uvec3 bc = resoct_brick_at(Lc, bs, cell);
     uint ec = resoct_page_entry_of(s.slot, lu, f.level_count, Lc, bc);
     if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_entry_source(s, ec, lu, bc);
+      return resoct_entry_source(s, ec, lu, Lc, bs, bc);
     }
     l = resoct_node_next_coarser(r, lu);
   }
@@ -212,7 +285,7 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
     resoct_box_clip_brick(lo, hi, Lf, bs, bf);
     uint ef = resoct_page_entry_of(s.slot, lu, f.level_count, Lf, bf);
     if (resoct_page_state(ef) != RESOCT_PAGE_STATE_UNMAPPED) {
-      return resoct_entry_source(s, ef, lu, bf);
+      return resoct_entry_source(s, ef, lu, Lf, bs, bf);
     }
     l = resoct_node_next_finer(r, lu);
   }
@@ -228,7 +301,7 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
   ivec3 hi = cell + ivec3(1);
   ResoctSource src =
       resoct_residency_source(f, s, node, lo, hi, target, cell, last_key, lo, hi, st);
-  return resoct_source_sample(f, s, src, cell, frac, value, st);
+  return resoct_source_sample(f, src, cell, frac, value, st);
 }
 
 /// Page-table mode, one channel: the target level or nothing (requested); [lo, hi) is clipped to
@@ -248,7 +321,7 @@ RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotI
     resoct_request_missing(f, s, target, cell, last_key, st);
     return resoct_source_of(RESOCT_CH_NONE, 0.0f);
   }
-  ResoctSource src = resoct_entry_source(s, e, target, b);
+  ResoctSource src = resoct_entry_source(s, e, target, L, bs, b);
   if (src.kind == RESOCT_CH_EMPTY) {
     skip_exit =
         resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b), resoct_brick_size0(L, bs));
@@ -295,7 +368,8 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
     best_brick = b;
   }
   if (best_entry == RESOCT_PAGE_UNMAPPED_WORD) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
-  return resoct_entry_source(s, best_entry, best_level, best_brick);
+  return resoct_entry_source(s, best_entry, best_level, resoct_read_level(best_level), bs,
+                             best_brick);
 }
 
 RESOCT_KERNEL_END

@@ -37,8 +37,12 @@ inline int findLSB(uint v) {
 inline int findMSB(uint v) {
   return v == 0u ? -1 : 31 - __builtin_clz(v);
 }
+// Without -mpopcnt (the x86-64 baseline) __builtin_popcount is a library call; this is a dozen
+// inline instructions.
 inline int bitCount(uint v) {
-  return __builtin_popcount(v);
+  v = v - ((v >> 1) & 0x55555555u);
+  v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+  return int((((v + (v >> 4)) & 0x0F0F0F0Fu) * 0x01010101u) >> 24);
 }
 }  // namespace resoct::kernel
 

@@ -203,6 +203,9 @@ struct ResoctDepthInfo {
   uint node_extent_x;  // voxels per node per axis (before clamping)
   uint node_extent_y;
   uint node_extent_z;
+  uint count_log2_x;  // log2 of count_x .. count_z (counts are powers of two)
+  uint count_log2_y;
+  uint count_log2_z;
 };
 
 // What one ray reports besides its colour (summed per frame by the backend).

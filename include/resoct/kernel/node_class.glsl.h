@@ -86,7 +86,7 @@ RESOCT_FN uint resoct_traversal_depth(ResoctFrame f, float dt) {
 
 /// log2 of the node counts per axis at depth D (counts are powers of two).
 RESOCT_FN uvec3 resoct_depth_count_log2(ResoctDepthInfo D) {
-  return uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
+  return uvec3(D.count_log2_x, D.count_log2_y, D.count_log2_z);
 }
 
 /// Coordinates at depth D of the ancestor of the node with coordinates `deep` at a deeper depth

@@ -195,17 +195,17 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       stats.iterations = stats.iterations + 1u;
       float seg = resoct_segment_length(t, dt, t_exit);
       float tm = t + 0.5f * seg;
-      ivec3 cell;
-      vec3 frac;
-      resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
-      resoct_clamp_position(f, cell, frac);
+      // The exact position (integer cell + fraction) is needed only where decisions are made:
+      // at a segment's first sample, and by effects.
+      ivec3 cell = ivec3(0);
+      vec3 frac = vec3(0.0f);
 
       bool skip = false;
       float skip_exit = RESOCT_RAY_T_INF;
-      if (!have_seg || !(tm < seg_t_end) || any(lessThan(cell, seg_lo)) ||
-          any(greaterThanEqual(cell, seg_hi)) ||
-          (all(greaterThanEqual(cell, ex_lo)) && all(lessThan(cell, ex_hi)))) {
+      if (!have_seg || !(tm < seg_t_end)) {
         // ---- A new segment: decide every channel's source at this sample. ----
+        resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
+        resoct_clamp_position(f, cell, frac);
         float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
                                               resoct_view_depth(f, dir_box, tm), f.lod_error_px);
         uint lod = resoct_lod_level(budget, f.level_count);
@@ -244,7 +244,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           }
           // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
           bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
-                           all(greaterThanEqual(cell, cached_lo)) && all(lessThan(cell, cached_hi));
+                           resoct_in_box(cell, cached_lo, cached_hi);
           if (!same_node) {
             ResoctDepthInfo Dt = resoct_read_depth(cap_depth);
             uvec3 trav_coord = resoct_node_coord(Dt, cell);
@@ -384,7 +384,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             ivec3 nlo = ivec3(resoct_node_coord(Ds, cell)) * ne;
             ivec3 ilo = nlo + margin;
             ivec3 ihi = nlo + ne - margin;
-            if (all(greaterThanEqual(cell, ilo)) && all(lessThan(cell, ihi))) {
+            if (resoct_in_box(cell, ilo, ihi)) {
               skip = true;
               skip_exit = resoct_box_exit(cell, frac, dir_vox, ilo, vec3(ihi - ilo));
             } else {
@@ -400,7 +400,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                 any(greaterThan(margin, ivec3(0)))) {
               ivec3 ilo = cached_lo + margin;
               ivec3 ihi = cached_hi - margin;
-              if (all(greaterThanEqual(cell, ilo)) && all(lessThan(cell, ihi))) {
+              if (resoct_in_box(cell, ilo, ihi)) {
                 resoct_box_clip(seg_lo, seg_hi, ilo, ihi);
               } else {
                 use_class = false;
@@ -420,7 +420,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               if (use_class && ((cached_homog >> c) & 1u) != 0u) {
                 uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
                                            RESOCT_NODE_MINMAX);
-                src[c] = resoct_source_of(RESOCT_CH_VALUE, float(resoct_node_min16(mm)) / 65535.0f);
+                src[c] = resoct_source_value(s, float(resoct_node_min16(mm)) / 65535.0f);
               } else {
                 uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
                 src[c] = resoct_residency_source(sp, s, node, node_lo, node_hi, target, cell,
@@ -452,7 +452,19 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           }
           skip = all_empty;
         }
-        if (skip) have_seg = false;
+        if (skip) {
+          have_seg = false;
+        } else {
+          // The segment ends where the ray leaves its box, or enters the shrunk node in whose
+          // rim it started, or the LOD level may change (docs/rendering.md "Segments").
+          seg_t_end = min(seg_t_end, tm + resoct_box_exit_t(cell, frac, dir_vox, seg_lo, seg_hi));
+          if (ex_lo != ex_hi) {
+            seg_t_end = min(seg_t_end, tm + resoct_box_entry_t(cell, frac, dir_vox, ex_lo, ex_hi));
+          }
+          for (uint c = 0u; c < n; ++c) {
+            src[c] = resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
+          }
+        }
       }
 
       bool any_value = false;
@@ -468,12 +480,16 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         float fx_value[RESOCT_MAX_SLOTS];
         uint fx_level[RESOCT_MAX_SLOTS];
         uint fx_have = 0u;
+        RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+          resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
+          resoct_clamp_position(f, cell, frac);
+        }
         for (uint c = 0u; c < n; ++c) {
           if (src[c].kind != RESOCT_CH_VALUE) continue;
-          ResoctSlotInfo s = resoct_read_slot(bank + c);
           float value;
-          resoct_source_sample(sp, s, src[c], cell, frac, value, stats);
+          resoct_source_sample_t(src[c], tm, value, stats);
           RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
+            ResoctSlotInfo s = resoct_read_slot(bank + c);
             uint level = resoct_channel_level(seg_lod, s.finest_level, s.coarsest_level);
             RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
               if (f.mode == RESOCT_MODE_RESIDENCY) {
@@ -487,7 +503,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             fx_have = fx_have | (1u << c);
           }
           else {
-            vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, value, seg / f.ref_step);
+            vec4 rgba =
+                RESOCT_FX(resoct_dvr_sample)(pr, c, src[c].tf_slot, value, seg / f.ref_step);
             resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
           }
           any_value = true;
