@@ -166,7 +166,8 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;
   c.type = config_.voxel_type;
-  c.padded = glm::ivec3(config_.padded_brick);
+  c.geometry = detail::BrickGeometry(glm::ivec3(config_.padded_brick));
+  c.brick_bytes = slot_voxels_ * voxel_bytes_;
   c.brick_requests = brick_requests_.get();
   c.node_requests = node_requests_.get();
   c.used = used_bits_.get();

@@ -22,6 +22,23 @@
 
 namespace resoct::cpu::detail {
 
+// The padded brick's shape as the trilinear lookup uses it, computed once per render.
+struct BrickGeometry {
+  glm::vec3 hi{0.0f};                  // padded - 1: the last voxel centre (minus 0.5) per axis
+  glm::ivec3 last_cell{0};             // max(padded - 2, 0): the last cell with a +1 neighbour
+  std::size_t dx = 0, dy = 0, dz = 0;  // strides to the +1 neighbour (0 on a one-voxel axis)
+  std::size_t row = 0, slice = 0;      // padded.x, padded.x * padded.y
+
+  explicit BrickGeometry(glm::ivec3 padded = glm::ivec3(1))
+      : hi(glm::vec3(padded - 1)),
+        last_cell(glm::max(padded - 2, glm::ivec3(0))),
+        dx(padded.x > 1 ? 1u : 0u),
+        dy(padded.y > 1 ? std::size_t(padded.x) : 0u),
+        dz(padded.z > 1 ? std::size_t(padded.x) * std::size_t(padded.y) : 0u),
+        row(std::size_t(padded.x)),
+        slice(std::size_t(padded.x) * std::size_t(padded.y)) {}
+};
+
 // Everything the kernel's accessors read during one render(), built by CpuBackend::render on its
 // stack, so that backends in one process render at the same time.
 struct KernelContext {
@@ -38,7 +55,8 @@ struct KernelContext {
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
   VoxelType type = VoxelType::u8;
-  glm::ivec3 padded{1};
+  BrickGeometry geometry;
+  std::size_t brick_bytes = 0;  // slot_voxels * voxel size
   RequestSet* brick_requests = nullptr;
   RequestSet* node_requests = nullptr;
   std::atomic<std::uint64_t>* used = nullptr;
@@ -65,22 +83,18 @@ inline float clamp_coord(float v, float hi) {
 // Always inlined into the kernel's sampling: left to the growth heuristics, GCC moved it out of
 // the march once the kernel unit grew (slices and lens), +2 % instructions per frame (callgrind).
 template <class T>
-[[gnu::always_inline]] inline float trilinear(const std::byte* brick, glm::ivec3 padded,
+[[gnu::always_inline]] inline float trilinear(const std::byte* brick, const BrickGeometry& g,
                                               glm::vec3 pos) {
   // Clamp to the outermost voxel centres (clamp-to-edge), then interpolate the 2x2x2 cell.
-  const float cx = clamp_coord(pos.x - 0.5f, float(padded.x - 1));
-  const float cy = clamp_coord(pos.y - 0.5f, float(padded.y - 1));
-  const float cz = clamp_coord(pos.z - 0.5f, float(padded.z - 1));
-  const int x0 = std::min(int(cx), std::max(padded.x - 2, 0));
-  const int y0 = std::min(int(cy), std::max(padded.y - 2, 0));
-  const int z0 = std::min(int(cz), std::max(padded.z - 2, 0));
-  const std::size_t dx = x0 + 1 < padded.x ? 1u : 0u;
-  const std::size_t dy = y0 + 1 < padded.y ? std::size_t(padded.x) : 0u;
-  const std::size_t dz = z0 + 1 < padded.z ? std::size_t(padded.x) * std::size_t(padded.y) : 0u;
+  const float cx = clamp_coord(pos.x - 0.5f, g.hi.x);
+  const float cy = clamp_coord(pos.y - 0.5f, g.hi.y);
+  const float cz = clamp_coord(pos.z - 0.5f, g.hi.z);
+  const int x0 = std::min(int(cx), g.last_cell.x);
+  const int y0 = std::min(int(cy), g.last_cell.y);
+  const int z0 = std::min(int(cz), g.last_cell.z);
   const float fx = cx - float(x0), fy = cy - float(y0), fz = cz - float(z0);
-  const std::size_t i =
-      (std::size_t(z0) * std::size_t(padded.y) + std::size_t(y0)) * std::size_t(padded.x) +
-      std::size_t(x0);
+  const std::size_t i = std::size_t(z0) * g.slice + std::size_t(y0) * g.row + std::size_t(x0);
+  const std::size_t dx = g.dx, dy = g.dy, dz = g.dz;
   const float v000 = load_voxel<T>(brick, i), v100 = load_voxel<T>(brick, i + dx);
   const float v010 = load_voxel<T>(brick, i + dy), v110 = load_voxel<T>(brick, i + dy + dx);
   const float v001 = load_voxel<T>(brick, i + dz), v101 = load_voxel<T>(brick, i + dz + dx);
@@ -97,7 +111,9 @@ template <class T>
 
 }  // namespace resoct::cpu::detail
 
-// The kernel's accessors (kernel/traverse.glsl.h) over the context above.
+// The kernel's accessors (kernel/traverse.glsl.h) over the context above. Records are returned
+// by reference: the kernel reads a few fields of each, and a by-value copy of a whole record per
+// read was measurable in the descent (callgrind).
 namespace resoct::kernel {
 
 inline uint resoct_read_node(uint index) {
@@ -112,13 +128,13 @@ inline uint resoct_read_directory(uint index) {
 inline uint resoct_read_directory_offset(uint table) {
   return cpu::detail::t_ctx->directory_offsets[table];
 }
-inline ResoctSlotInfo resoct_read_slot(uint i) {
+inline const ResoctSlotInfo& resoct_read_slot(uint i) {
   return cpu::detail::t_ctx->slots[i];
 }
-inline ResoctLevelInfo resoct_read_level(uint l) {
+inline const ResoctLevelInfo& resoct_read_level(uint l) {
   return cpu::detail::t_ctx->levels[l];
 }
-inline ResoctDepthInfo resoct_read_depth(uint d) {
+inline const ResoctDepthInfo& resoct_read_depth(uint d) {
   return cpu::detail::t_ctx->depths[d];
 }
 inline vec4 resoct_read_tf(uint slot, uint index) {
@@ -135,11 +151,11 @@ inline float resoct_read_level_size_log2(uint level) {
 }
 inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
   const auto& c = *cpu::detail::t_ctx;
-  const std::byte* brick = c.cache + std::size_t(cache_slot) * c.slot_voxels * voxel_size(c.type);
+  const std::byte* brick = c.cache + std::size_t(cache_slot) * c.brick_bytes;
   switch (c.type) {
-    case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.padded, pos);
-    case VoxelType::u16: return cpu::detail::trilinear<std::uint16_t>(brick, c.padded, pos);
-    case VoxelType::f32: return cpu::detail::trilinear<float>(brick, c.padded, pos);
+    case VoxelType::u8: return cpu::detail::trilinear<std::uint8_t>(brick, c.geometry, pos);
+    case VoxelType::u16: return cpu::detail::trilinear<std::uint16_t>(brick, c.geometry, pos);
+    case VoxelType::f32: return cpu::detail::trilinear<float>(brick, c.geometry, pos);
   }
   return 0.0f;
 }

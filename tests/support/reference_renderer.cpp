@@ -208,7 +208,11 @@ glm::dvec4 reference_ray(const Scene& scene, const VolumeDesc& volume, const Vox
         have_prev[ci] = true;
         continue;
       }
-      const glm::dvec4 rgba = c.tf.evaluate(x);
+      glm::dvec4 rgba = c.tf.evaluate(x);
+      if (options.sample_offset != glm::dvec3(0.0)) {
+        rgba = c.tf.evaluate(normalized(volume, voxels, c.channel, pos + options.sample_offset));
+      }
+      rgba.a = std::min(rgba.a * options.opacity_scale, 1.0);
       const double a = rgba.a >= 1.0 ? 1.0 : -std::expm1((t1 - t0) / delta0 * std::log1p(-rgba.a));
       glm::dvec3 rgb(rgba);
       if (shading && a > 0.0) {

@@ -43,6 +43,11 @@ struct ReferenceOptions {
   double step = 1.0 / 16.0;
   /// Apply the scene's early ray termination (the renderers under test do).
   bool early_termination = true;
+  /// Deliberate defects, for tests that show a tolerance can catch a bug: every DVR sample is
+  /// taken this far (level-0 voxels) from where it belongs, and its transfer-function opacity is
+  /// multiplied by opacity_scale (capped at 1). Both are off by default.
+  glm::dvec3 sample_offset{0.0};
+  double opacity_scale = 1.0;
 };
 
 /// Trilinear interpolation at a continuous level-0 voxel position (voxel i has its centre at

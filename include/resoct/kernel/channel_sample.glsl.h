@@ -159,15 +159,19 @@ RESOCT_FN void resoct_box_clip_brick(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3)
 RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint level,
                                            ResoctLevelInfo L, uvec3 brick_size, uvec3 brick) {
   uint state = resoct_page_state(entry);
+  ResoctSource src = resoct_source_of(RESOCT_CH_NONE, 0.0f);
   if (state == RESOCT_PAGE_STATE_EMPTY) {
-    if (!resoct_empty_page_shows(s, entry)) return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
-    return resoct_source_value(s, s.zero_value);
+    if (resoct_empty_page_shows(s, entry)) {
+      src = resoct_source_value(s, s.zero_value);
+    } else {
+      src.kind = RESOCT_CH_EMPTY;
+    }
+  } else if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
+    src = resoct_source_value(s, resoct_page_homogeneous_value(entry));
   }
-  if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
-    return resoct_source_value(s, resoct_page_homogeneous_value(entry));
-  }
-  if (state != RESOCT_PAGE_STATE_MAPPED) return resoct_source_of(RESOCT_CH_NONE, 0.0f);
-  ResoctSource src = resoct_source_value(s, 0.0f);
+  src.level = level;
+  if (state != RESOCT_PAGE_STATE_MAPPED) return src;
+  src = resoct_source_value(s, 0.0f);
   src.cache_slot = resoct_page_cache_slot(entry);
   src.level = level;
   src.brick = brick;

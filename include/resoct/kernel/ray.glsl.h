@@ -74,7 +74,7 @@ RESOCT_FN vec2 resoct_ray_node_local(vec3 origin_rel, vec3 dir, vec3 node_size) 
 /// Moves the integer/fraction split so that the fraction is in [0, 1) again, keeping
 /// cell + frac unchanged up to float rounding of the fraction.
 RESOCT_FN void resoct_split_normalize(RESOCT_INOUT(ivec3) cell, RESOCT_INOUT(vec3) frac) {
-  vec3 whole = floor(frac);
+  vec3 whole = resoct_floor(frac);
   cell = cell + ivec3(whole);
   frac = frac - whole;
 }

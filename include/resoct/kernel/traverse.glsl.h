@@ -166,19 +166,20 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   // extra loop back-edges per step, which count against the driver's per-invocation loop guard
   // (docs/vulkan-backend.md) and cut long rays short.
   bool stop = false;
-  // The current ray segment (docs/rendering.md "Segments"): while a sample's cell lies in
-  // [seg_lo, seg_hi) but not in [ex_lo, ex_hi), and before seg_t_end (where the LOD level
-  // changes), every channel's lookup (classification, level, page entry, substitution, requests,
-  // used slot) is that of the segment's first sample, kept in src[]: the samples in between only
-  // sample, look up the transfer function and composite.
-  bool have_seg = false;
-  ivec3 seg_lo = ivec3(0);
-  ivec3 seg_hi = ivec3(0);
-  ivec3 ex_lo = ivec3(0);
-  ivec3 ex_hi = ivec3(0);
-  float seg_t_end = 0.0f;
+  // The current ray segment (docs/rendering.md "Segments"): until seg_next, every channel's
+  // lookup (classification, level, page entry, substitution, requests, used slot) is that of the
+  // segment's first sample, kept in src[]: the samples in between only sample, look up the
+  // transfer function and composite.
+  bool have_seg = false;    // src[] holds sources (they may still need a new decision)
+  float lod_t_end = 0.0f;   // where the LOD level may change
+  float seg_t_end = 0.0f;   // where the sources stop holding (their boxes, the LOD level)
+  float node_t_end = 0.0f;  // where the residency node's classes stop holding
+  float seg_next = 0.0f;    // min(seg_t_end, node_t_end): the next decision
   uint seg_lod = 0u;
-  uint seg_node = 0u;
+  uint seg_node = 0u;         // node the sources were decided in
+  uint seg_empty = 0u;        // channels the node's classes settled then: empty,
+  uint seg_homog = 0u;        //   homogeneous
+  bool seg_node_dep = false;  // some source depends on that node
   ResoctSource src[RESOCT_MAX_SLOTS];
   // Residency mode: half a voxel of the coarsest level a live channel samples, per axis (0 at
   // level 0): node metadata covers the node dilated by one level-0 voxel, which covers the
@@ -202,24 +203,28 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
 
       bool skip = false;
       float skip_exit = RESOCT_RAY_T_INF;
-      if (!have_seg || !(tm < seg_t_end)) {
-        // ---- A new segment: decide every channel's source at this sample. ----
+      if (!have_seg || !(tm < seg_next)) {
+        // ---- A decision: the node's class (residency) and, where they may have changed, the
+        // channels' sources, all at this sample. ----
         resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
         resoct_clamp_position(f, cell, frac);
-        float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
-                                              resoct_view_depth(f, dir_box, tm), f.lod_error_px);
-        uint lod = resoct_lod_level(budget, f.level_count);
-        seg_lod = lod;
-        seg_t_end = resoct_lod_change_t(f.footprint_base, f.footprint_slope,
-                                        resoct_view_depth(f, dir_box, 1.0f), f.lod_error_px, lod,
-                                        f.level_count);
-        seg_lo = ivec3(-2147483647);
-        seg_hi = ivec3(2147483647);
-        ex_lo = ivec3(0);
-        ex_hi = ivec3(0);
-        have_seg = true;
-        for (uint c = 0u; c < n; ++c) src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
-
+        bool new_sources = !have_seg || !(tm < seg_t_end);
+        if (new_sources) {
+          float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
+                                                resoct_view_depth(f, dir_box, tm), f.lod_error_px);
+          seg_lod = resoct_lod_level(budget, f.level_count);
+          lod_t_end = resoct_lod_change_t(f.footprint_base, f.footprint_slope,
+                                          resoct_view_depth(f, dir_box, 1.0f), f.lod_error_px,
+                                          seg_lod, f.level_count);
+        }
+        uint lod = seg_lod;
+        node_t_end = RESOCT_RAY_T_INF;
+        // Residency mode: where the node's classes hold, and which channels they settle.
+        ivec3 class_lo = ivec3(0);
+        ivec3 class_hi = ivec3(0);
+        uint class_empty = 0u;
+        uint class_homog = 0u;
+        uint node = 0u;
         if (f.mode == RESOCT_MODE_RESIDENCY) {
           // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
           // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
@@ -252,6 +257,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
             cached_lo = ivec3(trav_coord * ne);
             cached_hi = cached_lo + ivec3(ne);
+            uvec3 prev_coord = cached_coord;
+            uint prev_depth = cached_depth;
             cached_coord = trav_coord;
             // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
             // node advances the channel index in the same node. `state` = channels empty so far
@@ -269,7 +276,35 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             cached_skip_depth = RESOCT_NONE_U;
             uint state = 0u;
             uint local = 0u;
-            for (uint d = 0u; d <= cap_depth; ++d) {
+            uint d_first = 0u;
+            if (on_path && prev_depth == cap_depth) {
+              // The deepest depth k of the previous path whose node is also the new node's
+              // ancestor (their coordinates agree above that depth's count bits): depths up to k
+              // are reused without walking them.
+              uvec3 diff = trav_coord ^ prev_coord;
+              uint k = reuse_end;
+              for (;;) {
+                uvec3 sh = trav_log2 - resoct_depth_count_log2(resoct_read_depth(k));
+                if ((diff.x >> sh.x) == 0u && (diff.y >> sh.y) == 0u && (diff.z >> sh.z) == 0u) {
+                  break;
+                }
+                if (k <= f.start_depth) {
+                  k = RESOCT_NONE_U;
+                  break;
+                }
+                k = k - 1u;
+              }
+              if (k != RESOCT_NONE_U) {
+                state = path_empty[k];
+                local = path_local[k];
+                d_first = k + 1u;
+                if (k == reuse_end && path_skip != 0u) {
+                  cached_skip_depth = k;
+                  d_first = cap_depth + 1u;
+                }
+              }
+            }
+            for (uint d = d_first; d <= cap_depth; ++d) {
               ResoctDepthInfo D = resoct_read_depth(d);
               if (d > 0u) {
                 local = (local << D.child_shift) |
@@ -373,98 +408,126 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               cached_node = Dk.first_node + path_local[cached_skip_depth];
             }
           }
-          uint node = cached_node;
+          node = cached_node;
           // A node's class holds in the node shrunk by the margin (the whole node at level 0);
-          // in the rest of it every live channel is looked up, and entering the shrunk part
-          // starts a new segment.
-          bool use_class = true;
+          // in the rest of it (the rim) every live channel is looked up, and entering the shrunk
+          // part is a new decision.
+          uint live_mask = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
           if (cached_skip_depth != RESOCT_NONE_U) {
             ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
             ivec3 ne = ivec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
-            ivec3 nlo = ivec3(resoct_node_coord(Ds, cell)) * ne;
-            ivec3 ilo = nlo + margin;
-            ivec3 ihi = nlo + ne - margin;
+            class_lo = ivec3(resoct_node_coord(Ds, cell)) * ne;
+            class_hi = class_lo + ne;
+            ivec3 ilo = class_lo + margin;
+            ivec3 ihi = class_hi - margin;
             if (resoct_in_box(cell, ilo, ihi)) {
               skip = true;
-              skip_exit = resoct_box_exit(cell, frac, dir_vox, ilo, vec3(ihi - ilo));
+              skip_exit = resoct_box_exit_t(cell, frac, dir_vox, ilo, ihi);
             } else {
-              use_class = false;
-              resoct_box_clip(seg_lo, seg_hi, nlo, nlo + ne);
-              ex_lo = ilo;
-              ex_hi = ihi;
+              node_t_end = min(resoct_box_exit_t(cell, frac, dir_vox, class_lo, class_hi),
+                               resoct_box_entry_t(cell, frac, dir_vox, ilo, ihi));
             }
           } else {
-            resoct_box_clip(seg_lo, seg_hi, cached_lo, cached_hi);
-            uint all_live = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
-            if (((cached_empty | cached_homog) & all_live) != 0u &&
-                any(greaterThan(margin, ivec3(0)))) {
-              ivec3 ilo = cached_lo + margin;
-              ivec3 ihi = cached_hi - margin;
-              if (resoct_in_box(cell, ilo, ihi)) {
-                resoct_box_clip(seg_lo, seg_hi, ilo, ihi);
-              } else {
-                use_class = false;
-                ex_lo = ilo;
-                ex_hi = ihi;
-              }
+            class_lo = cached_lo;
+            class_hi = cached_hi;
+            class_empty = cached_empty & live_mask;
+            class_homog = cached_homog & live_mask & ~class_empty;
+            ivec3 ilo = class_lo;
+            ivec3 ihi = class_hi;
+            if ((class_empty | class_homog) != 0u && any(greaterThan(margin, ivec3(0)))) {
+              ilo = ilo + margin;
+              ihi = ihi - margin;
+            }
+            if (resoct_in_box(cell, ilo, ihi)) {
+              node_t_end = resoct_box_exit_t(cell, frac, dir_vox, ilo, ihi);
+            } else {
+              class_empty = 0u;
+              class_homog = 0u;
+              node_t_end = min(resoct_box_exit_t(cell, frac, dir_vox, class_lo, class_hi),
+                               resoct_box_entry_t(cell, frac, dir_vox, ilo, ihi));
             }
           }
+          // Sources stay while they hold (their bricks, the LOD level) unless the classes
+          // settle other channels, or a source depends on the node (a substitute chosen by its
+          // residency word, a homogeneous node's value) and the node changed.
+          if (!skip && !new_sources &&
+              (class_empty != seg_empty || class_homog != seg_homog ||
+               (seg_node_dep && node != seg_node))) {
+            new_sources = true;
+          }
+        }
+        if (skip) {
+          // After the skip the class is decided anew; sources that still hold are kept.
+          node_t_end = 0.0f;
+        } else if (new_sources) {
+          ivec3 src_lo = ivec3(-2147483647);
+          ivec3 src_hi = ivec3(2147483647);
           seg_node = node;
-          if (!skip) {
-            ivec3 node_lo = seg_lo;
-            ivec3 node_hi = seg_hi;
+          seg_empty = class_empty;
+          seg_homog = class_homog;
+          seg_node_dep = false;
+          if (f.mode == RESOCT_MODE_RESIDENCY) {
             for (uint c = 0u; c < n; ++c) {
-              if (((live >> c) & 1u) == 0u) continue;
-              if (use_class && ((cached_empty >> c) & 1u) != 0u) continue;
+              src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
+              if ((((live & ~class_empty) >> c) & 1u) == 0u) continue;
               ResoctSlotInfo s = resoct_read_slot(bank + c);
-              if (use_class && ((cached_homog >> c) & 1u) != 0u) {
+              if (((class_homog >> c) & 1u) != 0u) {
+                // Homogeneous here: the node's value, no brick.
                 uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
                                            RESOCT_NODE_MINMAX);
                 src[c] = resoct_source_value(s, float(resoct_node_min16(mm)) / 65535.0f);
+                seg_node_dep = true;
               } else {
                 uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-                src[c] = resoct_residency_source(sp, s, node, node_lo, node_hi, target, cell,
-                                                 last_key[c], seg_lo, seg_hi, stats);
+                uint requests_before = stats.requests;
+                src[c] = resoct_residency_source(sp, s, node, class_lo, class_hi, target, cell,
+                                                 last_key[c], src_lo, src_hi, stats);
+                // A missing target (requested, perhaps substituted) depends on the node.
+                if (src[c].level != target || src[c].kind == RESOCT_CH_NONE ||
+                    stats.requests != requests_before) {
+                  seg_node_dep = true;
+                }
               }
             }
-          }
-        } else {
-          // Page-table and standard-octree modes: channels independently; skip only when every
-          // live channel is EMPTY, to the nearest EMPTY-brick exit.
-          bool all_empty = true;
-          for (uint c = 0u; c < n; ++c) {
-            if (((live >> c) & 1u) == 0u) continue;
-            ResoctSlotInfo s = resoct_read_slot(bank + c);
-            uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-            float exit_c = 0.0f;
-            if (f.mode == RESOCT_MODE_OCTREE) {
-              src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c], seg_lo,
-                                            seg_hi, exit_c, stats);
-            } else {
-              src[c] = resoct_pagetable_source(sp, s, target, cell, frac, dir_vox, last_key[c],
-                                               seg_lo, seg_hi, exit_c, stats);
+          } else {
+            // Page-table and standard-octree modes: channels independently; skip only when every
+            // live channel is EMPTY, to the nearest EMPTY-brick exit.
+            bool all_empty = true;
+            for (uint c = 0u; c < n; ++c) {
+              src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
+              if (((live >> c) & 1u) == 0u) continue;
+              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              float exit_c = 0.0f;
+              if (f.mode == RESOCT_MODE_OCTREE) {
+                src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                                              src_lo, src_hi, exit_c, stats);
+              } else {
+                src[c] = resoct_pagetable_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                                                 src_lo, src_hi, exit_c, stats);
+              }
+              if (src[c].kind == RESOCT_CH_EMPTY) {
+                skip_exit = min(skip_exit, exit_c);
+              } else {
+                all_empty = false;
+              }
             }
-            if (src[c].kind == RESOCT_CH_EMPTY) {
-              skip_exit = min(skip_exit, exit_c);
-            } else {
-              all_empty = false;
+            skip = all_empty;
+          }
+          if (skip) {
+            have_seg = false;
+          } else {
+            // The sources hold until the ray leaves their boxes or the LOD level may change
+            // (docs/rendering.md "Segments").
+            seg_t_end = min(lod_t_end, tm + resoct_box_exit_t(cell, frac, dir_vox, src_lo, src_hi));
+            have_seg = true;
+            for (uint c = 0u; c < n; ++c) {
+              src[c] = resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
             }
           }
-          skip = all_empty;
         }
-        if (skip) {
-          have_seg = false;
-        } else {
-          // The segment ends where the ray leaves its box, or enters the shrunk node in whose
-          // rim it started, or the LOD level may change (docs/rendering.md "Segments").
-          seg_t_end = min(seg_t_end, tm + resoct_box_exit_t(cell, frac, dir_vox, seg_lo, seg_hi));
-          if (ex_lo != ex_hi) {
-            seg_t_end = min(seg_t_end, tm + resoct_box_entry_t(cell, frac, dir_vox, ex_lo, ex_hi));
-          }
-          for (uint c = 0u; c < n; ++c) {
-            src[c] = resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
-          }
-        }
+        if (!skip) node_t_end = tm + node_t_end;
+        seg_next = min(seg_t_end, node_t_end);
       }
 
       bool any_value = false;
