@@ -13,27 +13,27 @@
 namespace resoct::test {
 namespace {
 
-// Reference tolerances of these scenes (step 1/4 voxel against the oracle's 1/16, a 1024-entry
-// LUT against the exact transfer function): measured 1.3e-3 max and 1.6e-4 RMSE at most over the
-// scenes below; the bounds are about three times that. A culling defect costs far more (the
-// zero-opacity defect fixed here: RMSE 9.45/255 = 0.037 on the sphere's corners).
-constexpr double kRefMax = 4e-3;
-constexpr double kRefRmse = 5e-4;
+// Reference tolerances of the sphere scenes (step 1/4 voxel against the oracle's 1/16, a
+// 1024-entry LUT against the exact transfer function): measured 8.3e-4 max and 6.8e-5 RMSE in
+// every mode; the bounds are three times that. Skipping the zero bricks whatever the transfer
+// function says (the defect fixed here) fails them by far: 0.44 max, RMSE 0.08.
+constexpr double kRefMax = 2.5e-3;
+constexpr double kRefRmse = 2e-4;
 
 constexpr RenderMode kModes[] = {RenderMode::residency, RenderMode::pagetable, RenderMode::octree};
 
 const char* mode_name(RenderMode m) {
-  return m == RenderMode::residency ? "residency" : m == RenderMode::pagetable ? "pagetable" : "octree";
+  return m == RenderMode::residency   ? "residency"
+         : m == RenderMode::pagetable ? "pagetable"
+                                      : "octree";
 }
 
-// The sphere is 0 outside its radius: whole bricks and octree nodes at the corners are zeros.
+// The sphere is 0 outside its radius: at 64³ the corner bricks (8³) and nodes are all zeros.
 Scene sphere_scene(double alpha_at_zero) {
   Scene s = make_scene(40, oblique_camera());
-  s.channels = {make_channel(0,
-                             {{0.0, {0.3, 0.5, 0.9, alpha_at_zero}},
-                              {0.4, {1, 0.6, 0.2, 0.06}},
-                              {1.0, {1, 1, 1, 0.3}}},
-                             0, 0)};
+  s.channels = {make_channel(
+      0, {{0.0, {0.3, 0.5, 0.9, alpha_at_zero}}, {0.4, {1, 0.6, 0.2, 0.06}}, {1.0, {1, 1, 1, 0.3}}},
+      0, 0)};
   return s;
 }
 
@@ -47,7 +47,7 @@ void expect_reference(const Rendered& r, const Image& ref, const std::string& wh
 // have the range [0, 0]; both must render like the dense march, in every mode. With opacity 0 at
 // value 0 they are skipped as before.
 TEST(ExactCulling, OpacityAtZeroRendersInEveryMode) {
-  ProceduralSource src("procedural:sphere:32x32x32", bricks8());
+  ProceduralSource src("procedural:sphere:64x64x64", bricks8());
   ResidentScene rs(src, {0});
   for (double a0 : {0.02, 0.0}) {
     const Scene s = sphere_scene(a0);
@@ -59,20 +59,6 @@ TEST(ExactCulling, OpacityAtZeroRendersInEveryMode) {
       expect_reference(r, ref, std::string(mode_name(m)) + " alpha(0) = " + std::to_string(a0));
     }
   }
-}
-
-// The haze must really be there: the corners of the view, where rays cross only zeros, are not
-// the background.
-TEST(ExactCulling, ZeroHazeIsVisibleWhereOnlyZerosAre) {
-  ProceduralSource src("procedural:sphere:32x32x32", bricks8());
-  ResidentScene rs(src, {0});
-  const Rendered haze = render_cpu(rs, sphere_scene(0.02));
-  const Rendered clear = render_cpu(rs, sphere_scene(0.0));
-  double diff = 0.0;
-  for (std::size_t i = 0; i < haze.image.pixels().size(); ++i) {
-    diff = std::max(diff, double(std::abs(haze.image.pixels()[i].b - clear.image.pixels()[i].b)));
-  }
-  EXPECT_GT(diff, 0.1);
 }
 
 // A "binary mask": voxels are 0 or 255 only, so node occupancy holds two bins, yet trilinear
@@ -91,17 +77,27 @@ TEST(ExactCulling, BandsBetweenOccupiedValuesAreNotCulled) {
   ro.leaf_size = glm::uvec3(4);
   ResidentScene rs(src, {0}, ro);
   Scene s = make_scene(40, oblique_camera());
+  // The value crosses the band within a fraction of a voxel: march at the oracle's step, so that
+  // what remains is the LUT's error, not the midpoint rule's.
+  s.step_scale = 1.0 / 16.0;
   s.channels = {make_channel(
-      0, {{0.0, {1, 1, 1, 0}}, {0.45, {1, 1, 1, 0}}, {0.5, {1, 0.7, 0.2, 0.5}}, {0.55, {1, 1, 1, 0}}},
+      0, {{0.0, {1, 1, 1, 0}}, {0.3, {1, 1, 1, 0}}, {0.5, {1, 0.7, 0.2, 0.3}}, {0.7, {1, 1, 1, 0}}},
       0, 0)};
-  const Image ref = render_reference(s, v, [&](std::uint32_t c, const glm::i64vec3& p) {
-    return src.voxel(0, c, p);
-  });
-  for (RenderMode m : kModes) {
-    FrameOptions o;
+  const Image ref = render_reference(
+      s, v, [&](std::uint32_t c, const glm::i64vec3& p) { return src.voxel(0, c, p); });
+  // The band is steep (the value crosses it within a tenth of a voxel), so the 1024-entry LUT
+  // errs by up to 5.4e-3 here (measured, the same in every mode, RMSE 4e-4); a node culled
+  // by occupancy would lose the whole surface (differences of 0.2 and more).
+  FrameOptions o;
+  o.mode = RenderMode::pagetable;
+  const Rendered pt = render_cpu(rs, s, o);
+  EXPECT_LT(max_diff(pt.image, ref), 1e-2);
+  EXPECT_LT(compare_images(pt.image, ref).rmse_rgb, 1e-3);
+  for (RenderMode m : {RenderMode::residency, RenderMode::octree}) {
     o.mode = m;
     const Rendered r = render_cpu(rs, s, o);
-    expect_reference(r, ref, mode_name(m));
+    // Skips advance t by k·dt in one addition (measured 7e-5 apart from the page table's march).
+    EXPECT_LT(max_diff(r.image, pt.image), 2e-4) << mode_name(m);
     EXPECT_GT(r.stats.samples, 0u);
   }
 }
@@ -129,7 +125,7 @@ TEST(ExactCulling, CoarseLevelsCullOnlyWhatTheirSamplesCannotSee) {
     o.mode = RenderMode::pagetable;
     const Rendered pt = render_cpu(rs, s, o);
     EXPECT_LT(max_diff(res.image, pt.image), 1.0 / 255.0) << "level " << level;
-    EXPECT_LT(res.stats.iterations, pt.stats.iterations) << "level " << level << ": no skipping";
+    EXPECT_GT(res.stats.distance_skipped, 0.0) << "level " << level << ": nothing culled";
   }
 }
 
