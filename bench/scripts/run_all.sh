@@ -65,7 +65,8 @@ for part in $only; do
     peers)
       # VTK's fixed-point ray caster vs resoct-render on the sphere; writes peer_vtk.json itself
       # (through a temporary file).
-      echo "== peers -> $results/peer_vtk.json ($(date -u +%H:%M:%S), load $(cut -d' ' -f1-3 /proc/loadavg))"
+      echo "== peers -> $results/peer_vtk.json ($(date -u +%H:%M:%S)," \
+        "load $(cut -d' ' -f1-3 /proc/loadavg))"
       /usr/bin/python3 bench/peers/vtk_raycast.py --resoct-render "$build/examples/resoct-render" \
         --out "$results/peer_vtk.json"
       ;;
