@@ -6,18 +6,19 @@
 #   bench/scripts/run_all.sh [--build DIR] [--only "table1 decoupling ..."] [--large]
 #
 # --build   build directory holding bench/resoct_bench_* (default: build)
-# --only    a subset of: table1 decoupling accuracy effects out_of_core scaling micro
+# --only    a subset of: table1 decoupling accuracy effects out_of_core scaling limit micro peers
+#           (default: all but peers; peers needs python3-vtk9 and xvfb, see bench/README.md)
 # --large   the `--large` preset (1024³ class, for machines with ≥ 16 GiB and many cores)
 #
 # Time on a quiet 2-core VM, standard preset: table1 ~10 min, decoupling ~7 min, accuracy ~4 min,
-# effects ~3 min, out_of_core ~15 min, scaling ~10 min, micro ~2 min. Each program's JSON is
-# written to a temporary file first and moved into bench/results only when the program succeeded,
-# so an interrupted run never leaves a truncated result behind.
+# effects ~3 min, out_of_core ~15 min, scaling ~10 min, limit ~5 min, micro ~2 min, peers ~1 min.
+# Each program's JSON is written to a temporary file first and moved into bench/results only when
+# the program succeeded, so an interrupted run never leaves a truncated result behind.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 build=build
-only="table1 decoupling accuracy effects out_of_core scaling micro"
+only="table1 decoupling accuracy effects out_of_core scaling limit micro"
 large=()
 while [ $# -gt 0 ]; do
   case $1 in
@@ -60,6 +61,15 @@ for part in $only; do
     effects) run effects effects --benchmark_min_time=0.01 ;;
     out_of_core) run out_of_core out_of_core ;;
     scaling) run scaling scaling --benchmark_min_time=0.01 ;;
+    limit) run limit limit --benchmark_min_time=2 ;;
+    peers)
+      # VTK's fixed-point ray caster vs resoct-render on the sphere; writes peer_vtk.json itself
+      # (through a temporary file).
+      echo "== peers -> $results/peer_vtk.json ($(date -u +%H:%M:%S)," \
+        "load $(cut -d' ' -f1-3 /proc/loadavg))"
+      /usr/bin/python3 bench/peers/vtk_raycast.py --resoct-render "$build/examples/resoct-render" \
+        --out "$results/peer_vtk.json"
+      ;;
     micro)
       large=()  # the micro-benchmarks have no presets
       run octree micro_octree --benchmark_filter='BM_Octree(AddEvict|Add|Evict)/16/4/0$' \
