@@ -1,7 +1,8 @@
 // Effects on the Vulkan backend against the CPU oracle: every effect specialization (shading,
 // shadows, isosurfaces, MIP, AIP, mixed) must give the CPU's integer outputs (statistics
 // including gradient evaluations and shadow rays, requests, used slots) and colours within
-// 2/255, with no validation message; each effect mask compiles one pipeline variant, reused.
+// kVulkanColourTolerance (1e-4), with no validation message; each effect mask compiles one pipeline
+// variant, reused.
 #include <cstdio>
 #include <string>
 #include <vector>

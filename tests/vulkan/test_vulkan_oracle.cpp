@@ -1,5 +1,6 @@
 // The Vulkan backend against the CPU backend (the oracle): the same resident state and tables
-// must give the same requests, used slots and integer statistics, and colours within 2/255.
+// must give the same requests, used slots and integer statistics, and colours within
+// kVulkanColourTolerance (1e-4).
 #include <cstdio>
 #include <vector>
 

@@ -1,6 +1,7 @@
 // Slices and the lens on Vulkan against the CPU oracle: the same kernel headers, so integer
 // outputs (statistics, request keys and hits, used cache slots) must be identical and colours
-// within 2/255, for slice scenes and lens scenes in all three render modes, warm and cold.
+// within kVulkanColourTolerance (1e-4), for slice scenes and lens scenes in all three render modes,
+// warm and cold.
 #include <cstdio>
 #include <string>
 
