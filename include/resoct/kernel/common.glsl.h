@@ -39,6 +39,9 @@ inline float resoct_floor1(float x) {
   const float r = float(int(x));
   return r > x ? r - 1.0f : r;
 }
+inline float resoct_ceil(float x) {
+  return -resoct_floor1(-x);
+}
 inline vec3 resoct_floor(vec3 v) {
   return vec3(resoct_floor1(v.x), resoct_floor1(v.y), resoct_floor1(v.z));
 }
@@ -97,6 +100,7 @@ inline int bitCount(uint v) {
 #define RESOCT_PRECISE
 #else
 #define resoct_floor(x) floor(x)
+#define resoct_ceil(x) ceil(x)
 #define resoct_exp2(x) exp2(x)
 #define resoct_log2(x) log2(x)
 #define RESOCT_FN

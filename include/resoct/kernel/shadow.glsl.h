@@ -105,7 +105,7 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
     if (empty == all) {
       uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
       float e = resoct_box_exit(cell, frac, dir_vox, ivec3(coord * ne), vec3(ne));
-      float k = max(1.0f, ceil((0.5f * seg + e - 0.5f * dt) / dt));
+      float k = max(1.0f, resoct_ceil((0.5f * seg + e - 0.5f * dt) / dt));
       t = resoct_advance_t(t, k * dt);
       continue;
     }

@@ -209,13 +209,15 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         resoct_ray_position(o_cell, o_frac, dir_vox, tm, cell, frac);
         resoct_clamp_position(f, cell, frac);
         bool new_sources = !have_seg || !(tm < seg_t_end);
-        if (new_sources) {
+        // The LOD level is chosen anew (per-sample rule) only past the point where it may change.
+        if (!(tm < lod_t_end)) {
           float budget = resoct_lod_budget_log2(f.footprint_base, f.footprint_slope,
                                                 resoct_view_depth(f, dir_box, tm), f.lod_error_px);
           seg_lod = resoct_lod_level(budget, f.level_count);
           lod_t_end = resoct_lod_change_t(f.footprint_base, f.footprint_slope,
                                           resoct_view_depth(f, dir_box, 1.0f), f.lod_error_px,
                                           seg_lod, f.level_count);
+          new_sources = true;
         }
         uint lod = seg_lod;
         node_t_end = RESOCT_RAY_T_INF;
@@ -603,7 +605,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       if (skip) {
         // First grid segment whose midpoint lies past the exit: sample positions stay those of
         // an unskipped march.
-        float k = max(1.0f, ceil((0.5f * seg + skip_exit - 0.5f * dt) / dt));
+        float k = max(1.0f, resoct_ceil((0.5f * seg + skip_exit - 0.5f * dt) / dt));
         float t_next = resoct_advance_t(t, k * dt);
         stats.skipped = stats.skipped + (min(t_next, t_exit) - t);
         t = t_next;
