@@ -91,8 +91,7 @@ struct ResoctSource {
                     // cache_slot != RESOCT_SOURCE_NO_SLOT, a mapped brick), RESOCT_CH_EMPTY
   float value;      // the constant (normalized) value
   uint cache_slot;  // mapped brick's cache slot, or RESOCT_SOURCE_NO_SLOT
-  uint level;       // level of the brick sampled
-  uvec3 brick;      // brick coordinates at that level
+  uint level;       // level of the page entry (target or substitute)
   // Per-segment constants of the sample path, so that a sample reads no table: the padded-brick
   // position of level-0 position (cell, frac) is (cell - core_lo + frac) * scale + halo.
   ivec3 core_lo;  // level-0 corner of the brick's core
@@ -114,7 +113,6 @@ RESOCT_FN ResoctSource resoct_source_of(uint kind, float value) {
   src.value = value;
   src.cache_slot = RESOCT_SOURCE_NO_SLOT;
   src.level = 0u;
-  src.brick = uvec3(0u);
   src.core_lo = ivec3(0);
   src.scale = vec3(1.0f);
   src.tf_slot = 0u;
@@ -161,26 +159,21 @@ RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint le
   uint state = resoct_page_state(entry);
   ResoctSource src = resoct_source_of(RESOCT_CH_NONE, 0.0f);
   if (state == RESOCT_PAGE_STATE_EMPTY) {
-    if (resoct_empty_page_shows(s, entry)) {
-      src = resoct_source_value(s, s.zero_value);
-    } else {
-      src.kind = RESOCT_CH_EMPTY;
-    }
+    src = resoct_empty_page_shows(s, entry) ? resoct_source_value(s, s.zero_value)
+                                            : resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
   } else if (state == RESOCT_PAGE_STATE_HOMOGENEOUS) {
     src = resoct_source_value(s, resoct_page_homogeneous_value(entry));
+  } else if (state == RESOCT_PAGE_STATE_MAPPED) {
+    src = resoct_source_value(s, 0.0f);
+    src.cache_slot = resoct_page_cache_slot(entry);
+    uvec3 fl = resoct_level_factor(L);
+    src.core_lo = resoct_brick_lo0(L, brick_size, brick);
+    src.scale = vec3(1.0f / float(1u << fl.x), 1.0f / float(1u << fl.y), 1.0f / float(1u << fl.z));
+    src.range_lo = s.range_lo;
+    src.inv_range_width = s.inv_range_width;
+    resoct_mark_used(src.cache_slot);
   }
   src.level = level;
-  if (state != RESOCT_PAGE_STATE_MAPPED) return src;
-  src = resoct_source_value(s, 0.0f);
-  src.cache_slot = resoct_page_cache_slot(entry);
-  src.level = level;
-  src.brick = brick;
-  uvec3 fl = resoct_level_factor(L);
-  src.core_lo = resoct_brick_lo0(L, brick_size, brick);
-  src.scale = vec3(1.0f / float(1u << fl.x), 1.0f / float(1u << fl.y), 1.0f / float(1u << fl.z));
-  src.range_lo = s.range_lo;
-  src.inv_range_width = s.inv_range_width;
-  resoct_mark_used(src.cache_slot);
   return src;
 }
 
@@ -345,8 +338,8 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
                                             RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
-  resoct_box_clip_brick(lo, hi, resoct_read_level(target), bs,
-                        resoct_brick_at(resoct_read_level(target), bs, cell));
+  ResoctLevelInfo Lt = resoct_read_level(target);
+  resoct_box_clip_brick(lo, hi, Lt, bs, resoct_brick_at(Lt, bs, cell));
   uint best_entry = RESOCT_PAGE_UNMAPPED_WORD;
   uint best_level = 0u;
   uvec3 best_brick = uvec3(0u);

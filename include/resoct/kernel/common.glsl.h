@@ -45,32 +45,6 @@ inline float resoct_ceil(float x) {
 inline vec3 resoct_floor(vec3 v) {
   return vec3(resoct_floor1(v.x), resoct_floor1(v.y), resoct_floor1(v.z));
 }
-// exp2 and log2 for the opacity correction: inline polynomials instead of libm calls (two calls
-// per channel sample were about a fifth of the plain sample's instructions). Accuracy: exp2 of
-// the fraction to 8e-8 relative (degree 5), log2 of the mantissa to 1.6e-7 absolute (degree 7),
-// least-squares fits on Chebyshev nodes; GPUs' exp2/log2 are approximations of the same order.
-// Arguments outside the normal range go to libm.
-inline float resoct_exp2(float x) {
-  if (!(x > -126.0f && x < 127.0f)) return glm::exp2(x);
-  const float xi = resoct_floor1(x);
-  const float f = x - xi;
-  const float p = 0.99999994f +
-                  f * (0.69315296f +
-                       f * (0.24015453f + f * (0.05582359f + f * (0.00899259f + f * 0.00187623f))));
-  return p * glm::uintBitsToFloat(std::uint32_t(int(xi) + 127) << 23);
-}
-inline float resoct_log2(float x) {
-  if (!(x >= 1.17549435e-38f && x <= 3.4e38f)) return glm::log2(x);
-  const std::uint32_t b = glm::floatBitsToUint(x);
-  const float e = float(int((b >> 23) & 255u) - 127);
-  const float t = glm::uintBitsToFloat((b & 0x007FFFFFu) | 0x3F800000u) - 1.0f;
-  return e + t * (1.4426947f +
-                  t * (-0.72130334f +
-                       t * (0.4799734f +
-                            t * (-0.35290268f +
-                                 t * (0.25468844f +
-                                      t * (-0.15349811f + t * (0.06230424f - t * 0.01195673f)))))));
-}
 inline int findLSB(uint v) {
   return v == 0u ? -1 : __builtin_ctz(v);
 }
@@ -101,8 +75,6 @@ inline int bitCount(uint v) {
 #else
 #define resoct_floor(x) floor(x)
 #define resoct_ceil(x) ceil(x)
-#define resoct_exp2(x) exp2(x)
-#define resoct_log2(x) log2(x)
 #define RESOCT_FN
 #define RESOCT_OUT(T) out T
 #define RESOCT_INOUT(T) inout T

@@ -39,7 +39,7 @@ RESOCT_FN float resoct_log_one_minus(float a) {
     return -a *
            (1.0f + a * (0.5f + a * (0.33333333f + a * (0.25f + a * (0.2f + a * 0.16666667f)))));
   }
-  return resoct_log2(1.0f - a) * RESOCT_LN2;
+  return log2(1.0f - a) * RESOCT_LN2;
 }
 
 /// 1 − e^y for y <= 0, accurate also for y near 0.
@@ -50,7 +50,7 @@ RESOCT_FN float resoct_one_minus_exp(float y) {
            (1.0f + y * (0.5f + y * (0.16666667f +
                                     y * (0.041666668f + y * (0.0083333333f + y * 0.0013888889f)))));
   }
-  return 1.0f - resoct_exp2(y * RESOCT_INV_LN2);
+  return 1.0f - exp2(y * RESOCT_INV_LN2);
 }
 
 /// Opacity of a step of `step_ratio` = Δ/Δ₀ reference steps for reference opacity `alpha`.
