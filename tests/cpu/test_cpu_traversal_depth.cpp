@@ -77,8 +77,9 @@ TEST(CpuTraversalDepth, IncrementalDescentMatchesNodeOwnClassification) {
     // from smaller jumps (docs/rendering.md, "Skipping keeps the sample grid").
     EXPECT_LT(max_diff(descent.image, flat.image), 1e-4) << view;
     EXPECT_LT(max_diff(descent.image, pt.image), 3e-4) << view;
-    // Skipping whole subtrees: fewer positions visited than without a descent.
-    EXPECT_LE(descent.stats.iterations, flat.stats.iterations) << view;
+    // Positions visited are not compared: a skip also goes on through the empty nodes that
+    // follow at its depth (runs, docs/rendering.md "Segments"), so the leaf-only render skips
+    // long stretches too, and which of the two needs fewer passes depends on the view.
     EXPECT_EQ(descent.stats.cap_hits, 0u);
     EXPECT_TRUE(descent.nodes.empty());
     total_samples += descent.stats.samples;

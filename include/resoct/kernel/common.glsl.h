@@ -68,6 +68,11 @@ inline int bitCount(uint v) {
 #define RESOCT_KERNEL_END }
 // Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
 #define RESOCT_FRAME_IN const ResoctFrame&
+// Read-only record parameter: by reference in C++, by value in GLSL.
+#define RESOCT_IN(T) const T&
+// A hot inner loop kept out of its caller in C++, so that the loop's registers are allocated for
+// the loop alone and not for the whole march around it (GLSL compilers inline it as usual).
+#define RESOCT_LOOP_FN [[gnu::noinline, gnu::flatten]] inline
 // Results that decide segment boundaries (slices, lens): `precise` in GLSL so that the device
 // does not contract them into fused multiply-adds (the CPU build never does), keeping iteration
 // counts identical between backends.
@@ -82,6 +87,8 @@ inline int bitCount(uint v) {
 #define RESOCT_KERNEL_BEGIN
 #define RESOCT_KERNEL_END
 #define RESOCT_FRAME_IN ResoctFrame
+#define RESOCT_IN(T) T
+#define RESOCT_LOOP_FN
 #define RESOCT_PRECISE precise
 #endif
 

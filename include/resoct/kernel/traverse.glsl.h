@@ -46,6 +46,7 @@
 #include "resoct/kernel/ray.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 #include "resoct/kernel/sample.glsl.h"
+#include "resoct/kernel/segment_samples.glsl.h"
 #include "resoct/kernel/segments.glsl.h"
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
@@ -63,6 +64,80 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.marched = 0.0f;
   st.gradient_evals = 0u;
   st.shadow_rays = 0u;
+}
+
+/// Most nodes beyond the current one that one residency decision classifies ahead along the ray.
+RESOCT_CONST(uint, RESOCT_NODE_RUN_LENGTH, 8u);
+
+/// Whether every live channel's own record at `node` has the class `cls` (EMPTY or VISIBLE).
+RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint node,
+                                     uint cls) {
+  for (uint c = 0u; c < n; ++c) {
+    if (((live >> c) & 1u) == 0u) continue;
+    if (resoct_node_class(node, resoct_read_slot(bank + c), f.node_slot_count) != cls) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The end of a run of nodes of one class along the ray. The run starts at the node of depth
+/// `depth` with coordinates `coord` and level-0 corner `lo`, which holds the sample at (cell,
+/// frac) and which the ray leaves at `node_end` (t relative to the sample); the nodes the ray
+/// enters next continue it while every live channel's own record has the class `cls`: EMPTY (a
+/// skip goes on through them) or VISIBLE (crossing into them is no decision). A node's metadata
+/// covers its subtree, so a node's own class for a channel is the class the descent would find
+/// there (no ancestor of a visible node is empty for the channel; an empty node's descendants are
+/// all empty). The run stops at the first other node (one without metadata included), at the
+/// volume's faces or the integer box [box_lo, box_hi), after RESOCT_NODE_RUN_LENGTH nodes, and
+/// where the ray leaves a node through an edge or a corner. Which face the ray leaves through is decided by comparing products, which
+/// both backends round alike (a quotient may differ in its last bit on a device), so that the
+/// nodes visited are the same on every backend; the exits themselves are computed from the
+/// sample's exact position, as the current node's is.
+RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint cls,
+                                    uint depth, uvec3 coord, ivec3 lo, ivec3 cell, vec3 frac,
+                                    vec3 dir_vox, float node_end, ivec3 box_lo, ivec3 box_hi,
+                                    RESOCT_INOUT(ResoctRayStats) stats) {
+  ResoctDepthInfo D = resoct_read_depth(depth);
+  ivec3 ne = ivec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
+  uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
+  uvec3 lg = resoct_depth_count_log2(D);
+  vec3 ad = abs(dir_vox);
+  float end = node_end;
+  for (uint i = 0u; i < RESOCT_NODE_RUN_LENGTH; ++i) {
+    // Distance to the far face per axis, in level-0 voxels (infinite where the ray is parallel):
+    // the exit along an axis is dist / |dir|, compared across axes as dist_a * |dir_b|.
+    vec3 rel = resoct_relative_origin(cell, frac, lo);
+    vec3 dist = vec3(dir_vox.x > 0.0f ? float(ne.x) - rel.x : rel.x,
+                     dir_vox.y > 0.0f ? float(ne.y) - rel.y : rel.y,
+                     dir_vox.z > 0.0f ? float(ne.z) - rel.z : rel.z);
+    bool px = ad.x < RESOCT_RAY_PARALLEL_EPS;
+    bool py = ad.y < RESOCT_RAY_PARALLEL_EPS;
+    bool pz = ad.z < RESOCT_RAY_PARALLEL_EPS;
+    RESOCT_PRECISE float xy = dist.x * ad.y;
+    RESOCT_PRECISE float yx = dist.y * ad.x;
+    RESOCT_PRECISE float xz = dist.x * ad.z;
+    RESOCT_PRECISE float zx = dist.z * ad.x;
+    RESOCT_PRECISE float yz = dist.y * ad.z;
+    RESOCT_PRECISE float zy = dist.z * ad.y;
+    // Axis a is the unique first exit when its exit is strictly before each other axis's.
+    bool x_first = !px && (py || xy < yx) && (pz || xz < zx);
+    bool y_first = !py && (px || yx < xy) && (pz || yz < zy);
+    bool z_first = !pz && (px || zx < xz) && (py || zy < yz);
+    if (!x_first && !y_first && !z_first) break;
+    uint axis = x_first ? 0u : (y_first ? 1u : 2u);
+    float d = axis == 0u ? dir_vox.x : (axis == 1u ? dir_vox.y : dir_vox.z);
+    int dstep = d > 0.0f ? 1 : -1;
+    // Unsigned: stepping below 0 wraps past the count.
+    coord[axis] = uint(int(coord[axis]) + dstep);
+    if (coord[axis] >= count[axis]) break;
+    lo[axis] = lo[axis] + dstep * ne[axis];
+    if (any(lessThan(lo, box_lo)) || any(greaterThan(lo + ne, box_hi))) break;
+    stats.nodes = stats.nodes + 1u;
+    if (!resoct_node_class_all(f, bank, n, live, resoct_node_index(depth, coord, lg), cls)) break;
+    end = max(end, resoct_box_exit_t(cell, frac, dir_vox, lo, lo + ne));
+  }
+  return end;
 }
 
 /// Renders one pixel with the effects of RESOCT_EFFECTS (kernel/effects.glsl.h): the
@@ -180,6 +255,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   uint seg_empty = 0u;        // channels the node's classes settled then: empty,
   uint seg_homog = 0u;        //   homogeneous
   bool seg_node_dep = false;  // some source depends on that node
+  uint seg_values = 0u;       // channels whose sources yield values (RESOCT_CH_VALUE)
+  ivec3 seg_box_lo = ivec3(0);  // the level-0 box in which the sources hold
+  ivec3 seg_box_hi = ivec3(0);
   ResoctSource src[RESOCT_MAX_SLOTS];
   // Residency mode: half a voxel of the coarsest level a live channel samples, per axis (0 at
   // level 0): node metadata covers the node dilated by one level-0 voxel, which covers the
@@ -425,6 +503,17 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             if (resoct_in_box(cell, ilo, ihi)) {
               skip = true;
               skip_exit = resoct_box_exit_t(cell, frac, dir_vox, ilo, ihi);
+              // At level 0 (no margin) the skip goes on through the empty nodes that follow.
+              bool run = all(equal(margin, ivec3(0)));
+              RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+                run = false;
+              }
+              if (run) {
+                skip_exit = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_EMPTY,
+                                                cached_skip_depth, resoct_node_coord(Ds, cell),
+                                                class_lo, cell, frac, dir_vox, skip_exit,
+                                                ivec3(-2147483647), ivec3(2147483647), stats);
+              }
             } else {
               node_t_end = min(resoct_box_exit_t(cell, frac, dir_vox, class_lo, class_hi),
                                resoct_box_entry_t(cell, frac, dir_vox, ilo, ihi));
@@ -522,14 +611,62 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             // The sources hold until the ray leaves their boxes or the LOD level may change
             // (docs/rendering.md "Segments").
             seg_t_end = min(lod_t_end, tm + resoct_box_exit_t(cell, frac, dir_vox, src_lo, src_hi));
+            seg_box_lo = src_lo;
+            seg_box_hi = src_hi;
             have_seg = true;
+            seg_values = 0u;
             for (uint c = 0u; c < n; ++c) {
               src[c] = resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
+              if (src[c].kind == RESOCT_CH_VALUE) seg_values = seg_values | (1u << c);
             }
           }
         }
+        // Consecutive nodes in which every live channel is visible form one segment: the
+        // nodes the ray enters next inside the sources' box are classified here, so that
+        // crossing into them is no decision (docs/rendering.md "Segments"). Only where nothing
+        // at the node settles a channel (no empty or homogeneous class, no source chosen by the
+        // node), and not for projections, whose classes follow the values along the ray.
+        bool merge = f.mode == RESOCT_MODE_RESIDENCY && !skip &&
+                     cached_skip_depth == RESOCT_NONE_U && class_empty == 0u &&
+                     class_homog == 0u && !seg_node_dep;
+        RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+          merge = false;
+        }
+        if (merge) {
+          node_t_end = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_VISIBLE, cap_depth,
+                                           cached_coord, class_lo, cell, frac, dir_vox,
+                                           node_t_end, seg_box_lo, seg_box_hi, stats);
+        }
         if (!skip) node_t_end = tm + node_t_end;
         seg_next = min(seg_t_end, node_t_end);
+      }
+
+      // Without effects, the samples of a segment whose only values come from one channel run
+      // in a loop of their own (kernel/segment_samples.glsl.h); else one sample per pass.
+      bool single = false;
+      RESOCT_IF_FX(RESOCT_EFFECT_ANY | RESOCT_EFFECT_PREINT) {}
+      else {
+        single = !skip && seg_values != 0u && (seg_values & (seg_values - 1u)) == 0u;
+      }
+      if (single) {
+        ResoctMarchState ms;
+        ms.t = t;
+        ms.seg = seg;
+        ms.tm = tm;
+        ms.acc = acc;
+        ms.samples = stats.samples;
+        ms.brick_accesses = stats.brick_accesses;
+        ms.iterations = stats.iterations;
+        ms.marched = stats.marched;
+        stop = resoct_segment_samples(f, src[findLSB(seg_values)], dt, t_exit, seg_next, ms);
+        t = ms.t;
+        acc = ms.acc;
+        stats.samples = ms.samples;
+        stats.brick_accesses = ms.brick_accesses;
+        stats.iterations = ms.iterations;
+        stats.marched = ms.marched;
+        if (stop) break;
+        continue;
       }
 
       bool any_value = false;

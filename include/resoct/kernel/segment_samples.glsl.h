@@ -1,0 +1,99 @@
+// resoct kernel: the samples of one ray segment with a single source, without effects.
+//
+// Between two decisions of the march (traverse.glsl.h, docs/rendering.md "Segments") every
+// channel's source is fixed. When one channel yields values there and no effect is on (the
+// plain kernel), a sample is only: the source's value at the padded-brick position affine in t,
+// the transfer function, the opacity correction and the "under" operator. This loop does exactly
+// that, with the same arithmetic as the general per-sample path (a single channel's intermixed
+// sample, weighted / combined, equals its premultiplied colour bit for bit), so images and
+// statistics do not depend on which path ran.
+//
+// In C++ the loop is a function of its own (RESOCT_LOOP_FN): the march around it holds the
+// decision state of all channels, and compiled into the march the loop's position, accumulator
+// and statistics lived in stack slots. GLSL compilers inline it.
+#ifndef RESOCT_KERNEL_SEGMENT_SAMPLES_GLSL_H
+#define RESOCT_KERNEL_SEGMENT_SAMPLES_GLSL_H
+
+#include "resoct/kernel/channel_sample.glsl.h"
+#include "resoct/kernel/common.glsl.h"
+#include "resoct/kernel/composite.glsl.h"
+#include "resoct/kernel/frame.glsl.h"
+#include "resoct/kernel/step.glsl.h"
+#include "resoct/kernel/tf.glsl.h"
+
+RESOCT_KERNEL_BEGIN
+
+/// Where a segment's samples stand: the ray parameter t of the current segment's start, its
+/// length seg and midpoint tm, the premultiplied accumulated colour, and the ray's counters.
+struct ResoctMarchState {
+  float t;
+  float seg;
+  float tm;
+  vec4 acc;
+  uint samples;
+  uint brick_accesses;
+  uint iterations;
+  float marched;
+};
+
+/// Samples `src` (RESOCT_CH_VALUE) from the state's current sample while its midpoint lies
+/// before `seg_next`. Returns true when the ray saturated (early termination); otherwise the
+/// state holds the next sample, which the march must see first: the ray's end, the iteration
+/// cap, or a new decision. Counts samples, brick accesses, iterations and marched length as the
+/// march's per-sample path does.
+RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src,
+                                           float dt, float t_exit, float seg_next,
+                                           RESOCT_INOUT(ResoctMarchState) m) {
+  // Local copies: in C++ the references could alias nothing here, but locals make it plain to
+  // the compiler (and cost nothing in GLSL).
+  float t = m.t;
+  float seg = m.seg;
+  float tm = m.tm;
+  vec4 acc = m.acc;
+  uint samples = m.samples;
+  uint accesses = m.brick_accesses;
+  uint iterations = m.iterations;
+  float marched = m.marched;
+  bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
+  bool saturated = false;
+  for (;;) {
+    float value = src.value;
+    if (mapped) {
+      accesses = accesses + 1u;
+      value = resoct_normalize_value(
+          resoct_sample_cache(src.cache_slot, src.ray_base + tm * src.ray_dir), src.range_lo,
+          src.inv_range_width);
+    }
+    vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
+    float alpha = resoct_correct_opacity(rgba.a, seg / f.ref_step);
+    samples = samples + 1u;
+    // resoct_mix_result of this one channel: its colour premultiplied (0 where alpha is 0).
+    vec4 sample_pm = alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha)
+                                  : vec4(0.0f);
+    acc = resoct_composite(acc, sample_pm);
+    if (resoct_saturated(acc, f.ert_opacity)) {
+      saturated = true;
+      break;
+    }
+    marched = marched + seg;
+    t = resoct_advance_t(t, seg);
+    if (!(t_exit - t > RESOCT_SEGMENT_EPS * dt) || iterations >= f.max_iterations) break;
+    seg = resoct_segment_length(t, dt, t_exit);
+    tm = t + 0.5f * seg;
+    if (!(tm < seg_next)) break;
+    iterations = iterations + 1u;
+  }
+  m.t = t;
+  m.seg = seg;
+  m.tm = tm;
+  m.acc = acc;
+  m.samples = samples;
+  m.brick_accesses = accesses;
+  m.iterations = iterations;
+  m.marched = marched;
+  return saturated;
+}
+
+RESOCT_KERNEL_END
+
+#endif  // RESOCT_KERNEL_SEGMENT_SAMPLES_GLSL_H
