@@ -90,10 +90,10 @@ RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint 
 /// there (no ancestor of a visible node is empty for the channel; an empty node's descendants are
 /// all empty). The run stops at the first other node (one without metadata included), at the
 /// volume's faces or the integer box [box_lo, box_hi), after RESOCT_NODE_RUN_LENGTH nodes, and
-/// where the ray leaves a node through an edge or a corner. Which face the ray leaves through is decided by comparing products, which
-/// both backends round alike (a quotient may differ in its last bit on a device), so that the
-/// nodes visited are the same on every backend; the exits themselves are computed from the
-/// sample's exact position, as the current node's is.
+/// where the ray leaves a node through an edge or a corner. Which face the ray leaves through is
+/// decided by comparing products, which both backends round alike (a quotient may differ in its
+/// last bit on a device), so that the nodes visited are the same on every backend; the exits
+/// themselves are computed from the sample's exact position, as the current node's is.
 RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint cls,
                                     uint depth, uvec3 coord, ivec3 lo, ivec3 cell, vec3 frac,
                                     vec3 dir_vox, float node_end, ivec3 box_lo, ivec3 box_hi,
@@ -251,11 +251,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   float node_t_end = 0.0f;  // where the residency node's classes stop holding
   float seg_next = 0.0f;    // min(seg_t_end, node_t_end): the next decision
   uint seg_lod = 0u;
-  uint seg_node = 0u;         // node the sources were decided in
-  uint seg_empty = 0u;        // channels the node's classes settled then: empty,
-  uint seg_homog = 0u;        //   homogeneous
-  bool seg_node_dep = false;  // some source depends on that node
-  uint seg_values = 0u;       // channels whose sources yield values (RESOCT_CH_VALUE)
+  uint seg_node = 0u;           // node the sources were decided in
+  uint seg_empty = 0u;          // channels the node's classes settled then: empty,
+  uint seg_homog = 0u;          //   homogeneous
+  bool seg_node_dep = false;    // some source depends on that node
+  uint seg_values = 0u;         // channels whose sources yield values (RESOCT_CH_VALUE)
   ivec3 seg_box_lo = ivec3(0);  // the level-0 box in which the sources hold
   ivec3 seg_box_hi = ivec3(0);
   ResoctSource src[RESOCT_MAX_SLOTS];
@@ -627,15 +627,15 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         // at the node settles a channel (no empty or homogeneous class, no source chosen by the
         // node), and not for projections, whose classes follow the values along the ray.
         bool merge = f.mode == RESOCT_MODE_RESIDENCY && !skip &&
-                     cached_skip_depth == RESOCT_NONE_U && class_empty == 0u &&
-                     class_homog == 0u && !seg_node_dep;
+                     cached_skip_depth == RESOCT_NONE_U && class_empty == 0u && class_homog == 0u &&
+                     !seg_node_dep;
         RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
           merge = false;
         }
         if (merge) {
           node_t_end = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_VISIBLE, cap_depth,
-                                           cached_coord, class_lo, cell, frac, dir_vox,
-                                           node_t_end, seg_box_lo, seg_box_hi, stats);
+                                           cached_coord, class_lo, cell, frac, dir_vox, node_t_end,
+                                           seg_box_lo, seg_box_hi, stats);
         }
         if (!skip) node_t_end = tm + node_t_end;
         seg_next = min(seg_t_end, node_t_end);
