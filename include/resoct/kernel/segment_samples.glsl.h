@@ -41,8 +41,8 @@ struct ResoctMarchState {
 /// state holds the next sample, which the march must see first: the ray's end, the iteration
 /// cap, or a new decision. Counts samples, brick accesses, iterations and marched length as the
 /// march's per-sample path does.
-RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src,
-                                           float dt, float t_exit, float seg_next,
+RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src, float dt,
+                                           float t_exit, float seg_next,
                                            RESOCT_INOUT(ResoctMarchState) m) {
   // Local copies: in C++ the references could alias nothing here, but locals make it plain to
   // the compiler (and cost nothing in GLSL).
@@ -68,8 +68,8 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
     float alpha = resoct_correct_opacity(rgba.a, seg / f.ref_step);
     samples = samples + 1u;
     // resoct_mix_result of this one channel: its colour premultiplied (0 where alpha is 0).
-    vec4 sample_pm = alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha)
-                                  : vec4(0.0f);
+    vec4 sample_pm =
+        alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha) : vec4(0.0f);
     acc = resoct_composite(acc, sample_pm);
     if (resoct_saturated(acc, f.ert_opacity)) {
       saturated = true;
