@@ -27,6 +27,7 @@
 #include "resoct/procedural_source.hpp"
 #include "resoct/raw_volume.hpp"
 #include "support/cli_parse.hpp"
+#include "support/output_path.hpp"
 #include "support/progress.hpp"
 #include "support/tool_main.hpp"
 
@@ -50,21 +51,6 @@ struct Args {
   std::uint32_t metadata_block = 16;
   std::uint32_t threads = 0;
 };
-
-// Fails before any work when the store could never be written, rather than after minutes of
-// conversion (the writer itself would also refuse, atomically).
-void check_output(const std::string& output) {
-  if (output.empty()) throw invalid_parameter("output", "empty path");
-  const std::size_t slash = output.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : output.substr(0, slash + 1);
-  struct stat st {};
-  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
-    throw file_error(ErrorCode::io, output, 0, "output directory '" + dir + "' does not exist");
-  }
-  if (::stat(output.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-    throw file_error(ErrorCode::io, output, 0, "output is a directory");
-  }
-}
 
 BrickLayout parse_layout(const Args& a) {
   BrickLayout layout;
@@ -199,7 +185,9 @@ int convert(const Args& a, const CLI::App& app) {
   }
   const BrickLayout layout = parse_layout(a);
   check_metadata_block(a.metadata_block);
-  check_output(a.output);
+  // Fails before any work when the store could never be written, rather than after minutes of
+  // conversion (the writer itself would also refuse, atomically).
+  check_output_path("output", a.output);
 
   std::unique_ptr<BrickSource> src;
   const char* const raw_options[] = {"--dims",     "--type",   "--endian", "--spacing",

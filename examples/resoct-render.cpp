@@ -19,6 +19,8 @@
 #include "resoct/open_source.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
+#include "support/cli_parse.hpp"
+#include "support/output_path.hpp"
 #include "support/tool_main.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
 #ifdef RESOCT_RENDER_WITH_VULKAN
@@ -168,6 +170,10 @@ int run(const Args& a) {
   o.leaf_size = glm::uvec3(a.leaf);
   if (a.frames == 0 && !a.converge)
     throw invalid_parameter("frames", "give --frames N or --converge");
+  // Both outputs are checked before rendering: a bad --stats path must not fail after the PNG
+  // has already replaced an existing one, nor after minutes of rendering.
+  if (!a.out.empty()) resoct::tools::check_output_path("out", a.out);
+  if (!a.stats.empty()) resoct::tools::check_output_path("stats", a.stats);
 
   Scene scene = load_scene(a.scene);
   if (a.width != 0) scene.viewport.width = a.width;
@@ -265,6 +271,14 @@ int main(int argc, char** argv) {
   app.add_option("--strategy", a.strategy, "greedy | global")->capture_default_str();
   app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  resoct::tools::one_line_usage_errors(app, "resoct-render");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Exit codes as every tool's (tool_main.hpp): CLI11's own codes (105, 109, ...) would not
+    // tell a usage error from a crash to a script.
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
   return resoct::tools::run_tool("resoct-render", [&] { return run(a); });
 }

@@ -45,8 +45,10 @@ class ByteStore {
 /// store).
 void check_store_key(std::string_view key);
 
-/// A ByteStore over a local directory: key "a/b" is the file <root>/a/b. Throws Error(io)
-/// naming `root` when it is not a readable directory.
+/// A ByteStore over a local directory: key "a/b" is the file <root>/a/b. Objects must resolve,
+/// symbolic links followed, to files below `root`: a get of a key whose path leads out of the
+/// store through a link throws Error(invalid_argument) naming `root` and the key. Throws
+/// Error(io) naming `root` when it is not a readable directory.
 std::shared_ptr<ByteStore> open_directory_store(std::string root);
 
 }  // namespace resoct

@@ -51,6 +51,11 @@ struct HttpOptions {
   std::uint32_t backoff_max_ms = 2000;
   /// Idle connections kept open for reuse (shared by all threads).
   std::uint32_t max_idle_connections = 32;
+  /// Origins beyond those of the URL map that a redirect may lead to, e.g.
+  /// "https://cdn.example.org" (only scheme, host and port are used). A redirect to any other
+  /// origin (another host or port, https to http, another scheme such as file://) fails with
+  /// Error(invalid_argument) naming the URL and the target; it is never followed.
+  std::vector<std::string> redirect_origins;
   /// Throws Error(invalid_argument) naming the field.
   void validate() const;
 };

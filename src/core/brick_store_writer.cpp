@@ -156,7 +156,21 @@ class Pipeline {
   }
 
  private:
+  /// A worker thread. Everything it does, the allocation of its brick buffer included, reports
+  /// through error_: an exception escaping a std::thread calls std::terminate, which aborted
+  /// resoct-convert (and left its temporary file behind) when that buffer did not fit in memory.
   void work() {
+    try {
+      work_jobs();
+    } catch (...) {
+      const std::lock_guard<std::mutex> g(m_);
+      if (!error_) error_ = std::current_exception();
+      ready_.notify_all();
+      space_.notify_all();
+    }
+  }
+
+  void work_jobs() {
     std::vector<std::byte> buf(h_.layout().padded_voxels() * voxel_size(h_.volume().type));
     for (;;) {
       std::uint64_t job = 0;
@@ -168,18 +182,10 @@ class Pipeline {
         if (stopping_ || error_ || next_job_ >= total()) return;
         job = next_job_++;
       }
-      try {
-        EncodedBrick b = encode(order_.key(job), buf);
-        const std::lock_guard<std::mutex> g(m_);
-        ring_[std::size_t(job % window_)] = std::move(b);
-        ready_.notify_all();
-      } catch (...) {
-        const std::lock_guard<std::mutex> g(m_);
-        if (!error_) error_ = std::current_exception();
-        ready_.notify_all();
-        space_.notify_all();
-        return;
-      }
+      EncodedBrick b = encode(order_.key(job), buf);
+      const std::lock_guard<std::mutex> g(m_);
+      ring_[std::size_t(job % window_)] = std::move(b);
+      ready_.notify_all();
     }
   }
 

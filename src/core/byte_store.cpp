@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "confined_path.hpp"
 #include "resoct/error.hpp"
 #include "resoct/file_io.hpp"
 
@@ -38,12 +39,12 @@ class DirectoryStore final : public ByteStore {
     if (!std::filesystem::is_directory(root_, ec)) {
       throw Error(ErrorCode::io, root_ + ": not a readable directory");
     }
+    canonical_root_ = detail::canonical_root(root_);
   }
 
   std::optional<std::vector<std::byte>> get(std::string_view key,
                                             std::uint64_t max_bytes) const override {
-    check_store_key(key);
-    std::string path = location(key);
+    const std::string path = resolve(key);
     std::error_code ec;
     // A missing object is an answer (zarr: fill value); anything else that stops the read is
     // an error reported by ReadFile with the path.
@@ -61,8 +62,7 @@ class DirectoryStore final : public ByteStore {
 
   std::vector<std::byte> get_range(std::string_view key, std::uint64_t offset,
                                    std::uint64_t size) const override {
-    check_store_key(key);
-    ReadFile file(location(key));
+    ReadFile file(resolve(key));
     // Checked before allocating: a corrupt index must not make us allocate what is not there.
     if (offset > file.size() || size > file.size() - offset) {
       throw file_error(ErrorCode::truncated, file.path(), offset,
@@ -79,7 +79,16 @@ class DirectoryStore final : public ByteStore {
   }
 
  private:
+  /// The file a key names. check_store_key() rules out absolute keys and '..' lexically; a
+  /// symbolic link inside the store (a chunk, a level directory) could still lead out of it, so
+  /// the resolved path must stay below the store's root as well.
+  std::string resolve(std::string_view key) const {
+    check_store_key(key);
+    return detail::confined_path(canonical_root_, key, root_, "store key").string();
+  }
+
   std::string root_;
+  std::filesystem::path canonical_root_;
 };
 
 }  // namespace

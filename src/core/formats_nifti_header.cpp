@@ -66,8 +66,9 @@ glm::dvec3 NiftiHeader::spacing() const noexcept {
 }
 
 bool NiftiHeader::scaled() const noexcept {
-  return !(scl_slope == 0.0f || scl_slope == 1.0f) || scl_inter != 0.0f ||
-         !std::isfinite(scl_slope) || !std::isfinite(scl_inter);
+  // NIfTI-1: "If the scl_slope field is nonzero, then each voxel value in the dataset should be
+  // scaled"; a zero slope means no scaling at all (scl_inter is then ignored too).
+  return scl_slope != 0.0f && (scl_slope != 1.0f || scl_inter != 0.0f);
 }
 
 std::size_t NiftiHeader::stored_voxel_bytes() const noexcept {
@@ -167,8 +168,13 @@ NiftiHeader parse_nifti_header(std::span<const std::byte> bytes, std::string_vie
                       "must be a whole number >= 348, got " + std::to_string(vox_offset));
   }
   h.vox_offset = std::uint64_t(vox_offset);
+  // Non-finite values read as 0, as niftilib's FIXED_FLOAT does: a NaN or infinite slope
+  // therefore means "no scaling" instead of turning every voxel into NaN or inf (an invisible
+  // volume), and a non-finite intercept is no offset.
   h.scl_slope = r.get<float>(112);
   h.scl_inter = r.get<float>(116);
+  if (!std::isfinite(h.scl_slope)) h.scl_slope = 0.0f;
+  if (!std::isfinite(h.scl_inter)) h.scl_inter = 0.0f;
   h.qform_code = r.get<std::int16_t>(252);
   h.sform_code = r.get<std::int16_t>(254);
   for (std::size_t row = 0; row < 3; ++row) {

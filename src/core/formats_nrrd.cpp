@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "confined_path.hpp"
 #include "formats_inflate.hpp"
 #include "formats_samples.hpp"
 #include "resoct/dense_volume.hpp"
@@ -76,9 +77,14 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   }
   std::string data_path = path;
   if (!attached) {
-    const std::filesystem::path p(h.data_file);
-    data_path =
-        p.is_absolute() ? p.string() : (std::filesystem::path(path).parent_path() / p).string();
+    // The header is untrusted: its data file may only be one below the header's own directory
+    // (no absolute path, no '..', no symbolic link leading out), or a header downloaded with a
+    // dataset could make resoct read any file the user can read.
+    std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    if (dir.empty()) dir = ".";
+    data_path = detail::confined_path(detail::canonical_root(dir), h.data_file, path,
+                                      "NRRD field 'data file'")
+                    .string();
   }
   const ReadFile data_file_handle = attached ? ReadFile(path) : ReadFile(data_path);
   const ReadFile& data = data_file_handle;

@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <tiffio.h>
 
+#include "confined_path.hpp"
 #include "resoct/dense_volume.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/pyramid_source.hpp"
@@ -156,17 +158,24 @@ std::vector<std::string> stack_files(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (!fs::is_directory(path, ec)) return {path};
-  std::vector<std::string> files;
+  // The directory is what the user named; its entries are not: a symbolic link among the
+  // slices must not make the stack read a file from elsewhere.
+  const fs::path root = detail::canonical_root(path);
+  std::vector<std::pair<std::string, std::string>> entries;  // (entry, resolved), sorted by entry
   for (const auto& e : fs::directory_iterator(path, ec)) {
     std::string ext = e.path().extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](char c) { return char(std::tolower(c)); });
-    if (e.is_regular_file() && (ext == ".tif" || ext == ".tiff"))
-      files.push_back(e.path().string());
+    if (e.is_regular_file() && (ext == ".tif" || ext == ".tiff")) {
+      entries.emplace_back(e.path().string(),
+                           detail::check_confined(root, e.path(), path).string());
+    }
   }
   if (ec) throw file_error(ErrorCode::io, path, 0, "cannot list directory: " + ec.message());
-  if (files.empty()) throw invalid_parameter("path", "'" + path + "' holds no .tif/.tiff files");
-  std::sort(files.begin(), files.end());
+  if (entries.empty()) throw invalid_parameter("path", "'" + path + "' holds no .tif/.tiff files");
+  std::sort(entries.begin(), entries.end());
+  std::vector<std::string> files;
+  for (auto& [entry, resolved] : entries) files.push_back(std::move(resolved));
   return files;
 }
 

@@ -12,6 +12,7 @@
 
 #include <curl/curl.h>
 
+#include "http_origin.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct {
@@ -195,7 +196,11 @@ bool transient(CURLcode c) {
   }
 }
 
-enum class Outcome { done, absent, retry, fail };
+enum class Outcome { done, absent, retry, fail, redirect };
+
+/// Redirect hops followed per attempt (libcurl's CURLOPT_MAXREDIRS before redirects were
+/// followed by hand).
+constexpr int kMaxRedirects = 5;
 
 }  // namespace
 
@@ -261,11 +266,17 @@ void HttpOptions::validate() const {
   if (max_idle_connections == 0 || max_idle_connections > 1024) {
     throw invalid_parameter("max_idle_connections", "must be 1..1024");
   }
+  for (const std::string& url : redirect_origins) {
+    if (!detail::http_origin(url)) {
+      throw invalid_parameter("redirect_origins", "'" + url + "' is not an http(s)://host URL");
+    }
+  }
 }
 
 struct HttpStore::Impl {
   UrlMap map;
   HttpOptions options;
+  std::vector<std::string> origins;  ///< where redirects may lead (redirect_allowed)
   CURLSH* share = nullptr;
   std::array<std::mutex, CURL_LOCK_DATA_LAST> share_locks;
   std::mutex pool_mutex;
@@ -312,16 +323,60 @@ struct HttpStore::Impl {
     return *best + "/" + percent_encode(key);
   }
 
-  /// One attempt; fills `why` for failures.
+  /// Whether a redirect may lead to `target`: only to an origin (scheme, host, port) that the
+  /// URL map or HttpOptions::redirect_origins names. libcurl's own redirect following can
+  /// only restrict schemes, so a hostile server could otherwise send the loader to any host
+  /// the machine reaches (a cloud metadata address, an intranet service) or downgrade https to
+  /// http; redirects are therefore followed here, one hop at a time.
+  bool redirect_allowed(const std::string& target) const {
+    const std::optional<std::string> o = detail::http_origin(target);
+    return o && std::find(origins.begin(), origins.end(), *o) != origins.end();
+  }
+
+  std::string origin_list() const {
+    std::string s;
+    for (const std::string& o : origins) s += (s.empty() ? "" : ", ") + o;
+    return s;
+  }
+
+  /// One attempt (following allowed redirects); fills `why` for failures.
   Outcome attempt(CURL* h, const std::string& url, bool head, Attempt& a, ErrorCode& code,
                   std::string& why) {
+    const Attempt request = a;
+    std::string target = url;
+    for (int hop = 0;; ++hop) {
+      const Outcome o = attempt_one(h, target, head, a, code, why);
+      if (o != Outcome::redirect) return o;
+      char* location = nullptr;
+      curl_easy_getinfo(h, CURLINFO_REDIRECT_URL, &location);
+      const std::string next = location != nullptr ? location : "";
+      if (hop == kMaxRedirects) {
+        code = ErrorCode::io;
+        why = "more than " + std::to_string(kMaxRedirects) + " redirects (last to '" + next + "')";
+        return Outcome::fail;
+      }
+      if (!redirect_allowed(next)) {
+        code = ErrorCode::invalid_argument;
+        why = "redirect (HTTP " + std::to_string(a.status) + ") to '" + next +
+              "' refused: it leaves the allowed origins (" + origin_list() + ")";
+        return Outcome::fail;
+      }
+      target = next;
+      a = request;  // forget what the redirect answer carried
+    }
+  }
+
+  /// One request, without following redirects.
+  Outcome attempt_one(CURL* h, const std::string& url, bool head, Attempt& a, ErrorCode& code,
+                      std::string& why) {
     curl_easy_reset(h);  // keeps the handle's connections, drops the previous request's options
     curl_easy_setopt(h, CURLOPT_URL, url.c_str());
     curl_easy_setopt(h, CURLOPT_NOSIGNAL, 1L);
     curl_easy_setopt(h, CURLOPT_SHARE, share);
     curl_easy_setopt(h, CURLOPT_PROTOCOLS_STR, "http,https");
-    curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 1L);
-    curl_easy_setopt(h, CURLOPT_MAXREDIRS, 5L);
+    // Redirects are followed by attempt(), which checks each target's origin first; the
+    // protocol list stays as a second line of defence.
+    curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 0L);
     curl_easy_setopt(h, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
     curl_easy_setopt(h, CURLOPT_CONNECTTIMEOUT_MS, long(options.connect_timeout_ms));
     curl_easy_setopt(h, CURLOPT_TIMEOUT_MS, long(options.total_timeout_ms));
@@ -365,6 +420,13 @@ struct HttpStore::Impl {
       return Outcome::fail;
     }
     if (a.complete_early) return Outcome::done;
+    if (rc == CURLE_OK && a.status >= 300 && a.status < 400) {
+      char* location = nullptr;
+      if (curl_easy_getinfo(h, CURLINFO_REDIRECT_URL, &location) == CURLE_OK &&
+          location != nullptr) {
+        return Outcome::redirect;
+      }
+    }
     if (rc != CURLE_OK) {
       const char* text = curl_error[0] ? curl_error : curl_easy_strerror(rc);
       code = rc == CURLE_PARTIAL_FILE ? ErrorCode::truncated : ErrorCode::io;
@@ -482,6 +544,17 @@ HttpStore::HttpStore(UrlMap map, HttpOptions options) : impl_(std::make_unique<I
     url = trim_slashes(url);
   }
   global_init();
+  // Redirects may lead to the hosts the caller named, and nowhere else.
+  auto allow = [&](const std::string& url) {
+    const std::optional<std::string> o = detail::http_origin(url);
+    if (!o) throw invalid_parameter("url_map", "'" + url + "' has no http(s) origin");
+    if (std::find(impl_->origins.begin(), impl_->origins.end(), *o) == impl_->origins.end()) {
+      impl_->origins.push_back(*o);
+    }
+  };
+  allow(map.base);
+  for (const auto& [prefix, url] : map.routes) allow(url);
+  for (const std::string& url : options.redirect_origins) allow(url);
   impl_->map = std::move(map);
   impl_->options = options;
   impl_->share = curl_share_init();

@@ -14,6 +14,7 @@
 #ifdef RESOCT_TEST_VULKAN
 #include "resoct/vulkan/devices.hpp"
 #include "resoct/vulkan/vulkan_backend.hpp"
+#include "support/vulkan_required.hpp"
 #endif
 
 namespace resoct::test {
@@ -35,7 +36,7 @@ class BackendTest : public ::testing::TestWithParam<std::string> {
       return;
     }
 #ifdef RESOCT_TEST_VULKAN
-    if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+    if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
     BackendOptions o;
     o.validation = true;
     auto v = std::make_unique<vk::VulkanBackend>(o);

@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -153,6 +155,57 @@ TEST(Nifti, ScalingSformSpacingAndVolumesAsChannels) {
   for (std::uint32_t c = 0; c < 3; ++c) {
     const auto v = level0_values(*src, c);
     for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(v[i], 0.5 * double((c * 12 + i) * 7) - 10.0);
+  }
+}
+
+// niftilib's rule: a NaN or infinite scl_slope / scl_inter reads as 0, and a zero slope means
+// no scaling at all (scl_inter ignored). A NaN slope used to scale every voxel to NaN: a volume
+// with no finite value, invisible, without a word.
+TEST(Nifti, NonFiniteOrZeroSlopeMeansNoScaling) {
+  TempDir dir;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  struct Case {
+    std::int16_t datatype, bitpix;
+    float slope, inter;
+    VoxelType type;
+    double scale, offset;  // expected value = scale * stored + offset
+  };
+  for (const Case c :
+       {Case{2, 8, nan, 0, VoxelType::u8, 1, 0}, Case{2, 8, inf, 0, VoxelType::u8, 1, 0},
+        Case{2, 8, -inf, 5, VoxelType::u8, 1, 0}, Case{2, 8, nan, nan, VoxelType::u8, 1, 0},
+        Case{2, 8, 0, 7, VoxelType::u8, 1, 0}, Case{512, 16, nan, -3, VoxelType::u16, 1, 0},
+        Case{4, 16, nan, 2, VoxelType::f32, 1, 0}, Case{16, 32, inf, 1, VoxelType::f32, 1, 0},
+        Case{2, 8, 2, nan, VoxelType::f32, 2, 0}, Case{2, 8, 2, -inf, VoxelType::f32, 2, 0},
+        Case{2, 8, 1, 0.5f, VoxelType::f32, 1, 0.5}}) {
+    SCOPED_TRACE("datatype " + std::to_string(c.datatype) + " slope " + std::to_string(c.slope) +
+                 " inter " + std::to_string(c.inter));
+    Spec s;
+    s.datatype = c.datatype;
+    s.bitpix = c.bitpix;
+    s.slope = c.slope;
+    s.inter = c.inter;
+    auto b = header(s);
+    std::vector<double> want;
+    for (int i = 0; i < 60; ++i) {
+      const double v = double(i * 3 + 1);
+      want.push_back(c.scale * v + c.offset);
+      if (c.datatype == 2) append(b, std::uint8_t(v), false);
+      if (c.datatype == 4) append(b, std::int16_t(-v), false), want.back() = -v;
+      if (c.datatype == 512) append(b, std::uint16_t(v), false);
+      if (c.datatype == 16) append(b, float(v), false);
+    }
+    const auto hb = std::as_bytes(std::span(b));
+    const NiftiHeader h = parse_nifti_header(hb, "s.nii");
+    EXPECT_TRUE(std::isfinite(h.scl_slope));
+    EXPECT_TRUE(std::isfinite(h.scl_inter));
+    EXPECT_EQ(h.scaled(), c.type == VoxelType::f32 && c.datatype == 2);
+    test::write_bytes(dir.file("s.nii"), b);
+    const auto src = open_nifti(dir.file("s.nii"), BrickLayout{glm::uvec3(4), 1});
+    EXPECT_EQ(src->volume().type, c.type);
+    EXPECT_EQ(level0_values(*src, 0), want);
+    const ValueRange r = src->volume().range(0);
+    EXPECT_TRUE(std::isfinite(r.lo) && std::isfinite(r.hi) && r.lo < r.hi);
   }
 }
 

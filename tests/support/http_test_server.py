@@ -14,6 +14,13 @@ The first path component selects a behaviour, the rest names the file below ROOT
   /fail/F      always 500
   /truncate/F  announces the full Content-Length, sends half the body, closes the connection
   /stall/F     accepts the request and sends nothing for 60 s
+  /redirect-ok/F    302 to /ok/F on this server (a relative Location)
+  /redirect-loop/F  302 to itself
+  /redirect-host/F  302 to http://localhost:<this port>/ok/F (same server, another host name)
+  /redirect-port/F  302 to http://127.0.0.1:<another port>/ok/F
+  /redirect-https/F 302 to https://127.0.0.1:<this port>/ok/F (another scheme)
+  /redirect-file/F  302 to file:///etc/passwd
+  /redirect-ftp/F   302 to ftp://127.0.0.1/F
   /_stats      JSON {"connections": n, "requests": n} since start or the last /_reset
   /_reset      zeroes the counters and the /flaky attempt counts
 """
@@ -77,6 +84,20 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 FLAKY.clear()
             return self.send_bytes(200, b"{}", send_body=send_body)
         rel = parts[1] if len(parts) > 1 else ""
+        if mode.startswith("redirect-"):
+            port = self.server.server_address[1]
+            target = {
+                "redirect-ok": "/ok/" + rel,
+                "redirect-loop": "/redirect-loop/" + rel,
+                "redirect-host": "http://localhost:%d/ok/%s" % (port, rel),
+                "redirect-port": "http://127.0.0.1:%d/ok/%s" % (port + 1 if port < 65535 else 1, rel),
+                "redirect-https": "https://127.0.0.1:%d/ok/%s" % (port, rel),
+                "redirect-file": "file:///etc/passwd",
+                "redirect-ftp": "ftp://127.0.0.1/" + rel,
+            }.get(mode)
+            if target is None:
+                return self.send_bytes(400, b"unknown mode", send_body=send_body)
+            return self.send_bytes(302, b"moved", [("Location", target)], send_body)
         path = os.path.realpath(os.path.join(ROOT, rel))
         if mode == "missing" or not path.startswith(ROOT + os.sep) or not os.path.isfile(path):
             return self.send_bytes(404, b"not found", send_body=send_body)

@@ -20,6 +20,7 @@
 
 #include "core/test_brick_store_util.hpp"
 #include "support/tool_process.hpp"
+#include "support/vulkan_required.hpp"
 #include "resoct/image.hpp"
 
 using resoct::test::slurp;
@@ -168,7 +169,11 @@ std::size_t line_count(const std::string& s) {
 
 TEST(RenderTool, ListDevicesPrintsEveryDeviceAndLavapipe) {
   TempDir dir;
-  if (const std::string why = vulkan_skip_reason(dir); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = vulkan_skip_reason(dir); why == "built without Vulkan") {
+    GTEST_SKIP() << why;  // nothing to require of a build configured without Vulkan
+  } else if (!why.empty()) {
+    RESOCT_SKIP_WITHOUT_VULKAN(why);
+  }
   const ToolRun r = run(dir, RESOCT_RENDER, "--list-devices");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // "0: <name> (<type>, Vulkan x.y.z, N MiB device-local)" per device, numbered from 0.
@@ -199,7 +204,11 @@ TEST(RenderTool, ListDevicesPrintsEveryDeviceAndLavapipe) {
 // CPU backend's within 2/255 per channel plus one 8-bit quantization step.
 TEST(RenderTool, VulkanBackendRendersEveryModeLikeTheCpuBackend) {
   TempDir dir;
-  if (const std::string why = vulkan_skip_reason(dir); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = vulkan_skip_reason(dir); why == "built without Vulkan") {
+    GTEST_SKIP() << why;  // nothing to require of a build configured without Vulkan
+  } else if (!why.empty()) {
+    RESOCT_SKIP_WITHOUT_VULKAN(why);
+  }
   for (const char* mode : {"residency", "pagetable", "octree"}) {
     std::map<std::string, resoct::Image> images;
     for (const char* backend : {"cpu", "vulkan"}) {

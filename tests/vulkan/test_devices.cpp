@@ -3,12 +3,13 @@
 #include <algorithm>
 
 #include "resoct/vulkan/devices.hpp"
+#include "support/vulkan_required.hpp"
 
 using namespace resoct;
 
 TEST(VulkanDevices, ListsAComputeCapableDeviceOrSkipsWithAReason) {
   const auto devices = vk::list_devices();
-  if (devices.empty()) GTEST_SKIP() << "no Vulkan device or ICD on this machine";
+  if (devices.empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device or ICD on this machine");
   for (std::size_t i = 0; i < devices.size(); ++i) {
     EXPECT_EQ(devices[i].index, i);
     EXPECT_FALSE(devices[i].name.empty());

@@ -10,6 +10,7 @@
 #include "vulkan_test_util.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/scene.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -67,7 +68,7 @@ std::vector<EffectCase> cases() {
 
 TEST(VulkanEffects, EverySpecializationMatchesTheCpuOracle) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   // Three channels of curved tubes crossing brick borders.
   ProceduralSource src("procedural:tubes:32x32x32:3", BrickLayout{glm::uvec3(8), 1});
   OracleDiff worst;
@@ -98,7 +99,7 @@ TEST(VulkanEffects, EverySpecializationMatchesTheCpuOracle) {
 // and MIP channels ignore it.
 TEST(VulkanEffects, PreintegrationWithEffectsMatchesTheCpuOracle) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   ProceduralSource src("procedural:tubes:32x32x32:3", BrickLayout{glm::uvec3(8), 1});
   OracleDiff worst;
   // Shading, an iso and a MIP channel, no shadows (mask 29: a smaller pipeline than all bits,

@@ -20,6 +20,7 @@
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -69,7 +70,7 @@ std::size_t expect_device_matches_host(const Renderer& r, const vk::VulkanBacken
 }
 
 TEST(VulkanDeltaUploads, ManyFramesWithEvictionAndRemapsMatchTheHostState) {
-  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   BrickLayout layout;
   layout.brick_size = glm::uvec3(8);
   layout.halo = 1;
@@ -149,7 +150,7 @@ TEST(VulkanDeltaUploads, ManyFramesWithEvictionAndRemapsMatchTheHostState) {
 }
 
 TEST(VulkanDeltaUploads, BlockAllocationAndReclaimMatchTheHostStateAndConverge) {
-  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   // 4^3 bricks over 512^3: level 0 is 128^3 bricks in 8^3 blocks, 589 blocks over all levels.
   BrickLayout layout;
   layout.brick_size = glm::uvec3(4);

@@ -11,6 +11,7 @@
 #include "support/expect_error.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/scene.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -27,7 +28,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL count_message(VkDebugUtilsMessageSeverityFlagBits
 }
 
 TEST(VulkanInterop, RendersWithAnApplicationDevice) {
-  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.apiVersion = VK_API_VERSION_1_2;
   const char* layer = "VK_LAYER_KHRONOS_validation";

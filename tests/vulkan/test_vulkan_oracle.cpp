@@ -7,6 +7,7 @@
 #include "vulkan_test_util.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/scene.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -77,7 +78,7 @@ void compare_all_modes(vk::VulkanBackend& gpu, const ResidentScene& rs, const Sc
 
 TEST(VulkanOracle, ShippedScenesAllModesMatchTheCpuBackend) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   for (const Case& c : kCases) {
     ProceduralSource src(c.spec, small_bricks());
     const Scene scene = shipped_scene(c.name);
@@ -92,7 +93,7 @@ TEST(VulkanOracle, ShippedScenesAllModesMatchTheCpuBackend) {
 // with RESOCT_EFFECT_PREINT) at coarse steps, where segments span many LUT bins.
 TEST(VulkanOracle, PreintegratedScenesAllModesMatchTheCpuBackend) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   for (const Case& c : {kCases[0], kCases[2], kCases[4]}) {
     ProceduralSource src(c.spec, small_bricks());
     Scene scene = shipped_scene(c.name);
@@ -106,7 +107,7 @@ TEST(VulkanOracle, PreintegratedScenesAllModesMatchTheCpuBackend) {
 
 TEST(VulkanOracle, MissingFineLevelsGiveTheSameRequests) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   // All u8: every distinct voxel type costs a pipeline compile (seconds on lavapipe); the
   // shipped-scene test covers u16 and f32.
   for (const char* name : {"turbulence", "noisefloor", "tubes"}) {
@@ -135,7 +136,7 @@ TEST(VulkanOracle, MissingFineLevelsGiveTheSameRequests) {
 
 TEST(VulkanOracle, PartialBricksAndU16AndF32Types) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   // A checkerboard of missing level-0 bricks over datasets of each voxel type.
   for (const char* spec : {"procedural:noisefloor:40x24x32", "procedural:cells:48x40x12:16",
                            "procedural:ramp:20x36x28"}) {

@@ -10,6 +10,7 @@
 #include "resoct/procedural_source.hpp"
 #include "resoct/scene.hpp"
 #include "vulkan_test_util.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -93,7 +94,7 @@ std::vector<Case> cases() {
 void run_cases(const std::string& spec, const ResidentOptions& resident, RequestStrategy strategy,
                const char* label) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device");
   ProceduralSource src(spec, small_bricks());
   ResidentScene rs(src, {0}, resident);
   cpu::CpuBackend cpu(1);
@@ -133,7 +134,7 @@ TEST(VulkanSlices, PartlyResidentGivesTheSameRequests) {
 // discrepancy of the volume march outside this work; 48² avoids that ray.
 TEST(VulkanSlices, ShippedSlicesSceneMatchesTheCpuBackend) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device");
   ProceduralSource src("procedural:tubes:64x64x64", small_bricks());
   ResidentOptions ro;
   ro.leaf_size = glm::uvec3(16);

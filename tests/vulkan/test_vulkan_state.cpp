@@ -9,6 +9,7 @@
 #include "support/expect_error.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/scene.hpp"
+#include "support/vulkan_required.hpp"
 
 namespace resoct::test {
 namespace {
@@ -124,7 +125,7 @@ void check_random_updates(vk::VulkanBackend& gpu, VoxelType type, std::uint32_t 
 
 TEST(VulkanState, RandomDeltasAndUploadsMatchTheHostArrays) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   check_random_updates(*gpu, VoxelType::u8, 1, 0);
   check_random_updates(*gpu, VoxelType::u16, 2, 0);
   check_random_updates(*gpu, VoxelType::f32, 3, 0);
@@ -137,7 +138,7 @@ TEST(VulkanState, RandomDeltasAndUploadsMatchTheHostArrays) {
 
 TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   FrameUpdate none;
   EXPECT_RESOCT_ERROR(gpu->update(none), ErrorCode::invalid_argument, "update");
   BackendConfig cfg;
@@ -180,7 +181,7 @@ TEST(VulkanState, BadUpdatesAndTablesAreRejected) {
 // nothing and renders the same image.
 TEST(VulkanState, PipelineVariantsAreCompiledOnceAndReused) {
   auto gpu = make_validated_vulkan();
-  if (!gpu) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (!gpu) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   auto layout = [](std::uint32_t brick) {
     BrickLayout l;
     l.brick_size = glm::uvec3(brick);
@@ -207,7 +208,7 @@ TEST(VulkanState, PipelineVariantsAreCompiledOnceAndReused) {
 }
 
 TEST(VulkanState, UnknownDeviceNameIsADeviceError) {
-  if (vk::list_devices().empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   BackendOptions o;
   o.device = "no-such-gpu-xyz";
   EXPECT_RESOCT_ERROR(vk::VulkanBackend{o}, ErrorCode::device, "device");
@@ -217,7 +218,7 @@ TEST(VulkanState, UnknownDeviceNameIsADeviceError) {
 
 TEST(VulkanState, RegisteredFactorySelectsByNameAndIndex) {
   const auto devices = vk::list_devices();
-  if (devices.empty()) GTEST_SKIP() << "no Vulkan device on this machine";
+  if (devices.empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
   vk::register_backend();
   BackendOptions o;
   o.validation = true;

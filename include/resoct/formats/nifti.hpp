@@ -3,10 +3,13 @@
 /// NIfTI-1 single-file volumes (.nii, and .nii.gz through zlib) as brick sources.
 ///
 /// Voxel mapping (the volume is served in voxel index order i, j, k = x, y, z; no reorientation):
-/// - u8 and u16 without scaling (scl_slope 0 or 1 and scl_inter 0) stay u8 / u16;
+/// - scl_slope and scl_inter that are NaN or infinite read as 0 (as in niftilib), and a
+///   scl_slope of 0 means no scaling, scl_inter ignored (the NIfTI-1 rule);
+/// - u8 and u16 without scaling (scl_slope 0, or 1 with scl_inter 0) stay u8 / u16;
 /// - i16 becomes f32 holding the same integer values (every i16 value is exact in f32, and
 ///   resoct has no signed type);
-/// - any scaling (scl_slope not 0 or 1, or scl_inter not 0) gives f32 = slope * v + inter;
+/// - any scaling (scl_slope not 0 and either not 1 or scl_inter not 0) gives
+///   f32 = slope * v + inter;
 /// - f32 stays f32.
 /// Spacing: the column lengths of the sform matrix when sform_code > 0, else |pixdim[1..3]|
 /// (qform and the fallback method share pixdim); a zero or non-finite spacing becomes 1.
@@ -38,8 +41,8 @@ struct NiftiHeader {
   NiftiDatatype datatype = NiftiDatatype::u8;
   std::array<float, 8> pixdim{};
   std::uint64_t vox_offset = 352;  ///< byte offset of the first voxel (>= 348)
-  float scl_slope = 0.0f;
-  float scl_inter = 0.0f;
+  float scl_slope = 0.0f;          ///< 0 when the file's value is NaN or infinite
+  float scl_inter = 0.0f;          ///< 0 when the file's value is NaN or infinite
   std::int16_t qform_code = 0;
   std::int16_t sform_code = 0;
   std::array<std::array<float, 4>, 3> srow{};  ///< srow_x, srow_y, srow_z

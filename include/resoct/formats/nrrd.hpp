@@ -56,8 +56,11 @@ struct NrrdHeader {
 NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location);
 
 /// Opens a .nrrd / .nhdr file as a brick source whose coarser levels are built on demand. A
-/// detached data file is resolved relative to the header's directory. Voxels are held in memory.
-/// Throws what parse_nrrd_header throws, Error(io) / Error(truncated) naming the data file.
+/// detached data file is resolved relative to the header's directory and must stay below it:
+/// an absolute path, a ".." component or a symbolic link leading out of that directory is
+/// Error(invalid_argument) naming the header and the data file (docs/formats.md, "Files a file
+/// may name"). Voxels are held in memory. Throws what parse_nrrd_header throws,
+/// Error(io) / Error(truncated) naming the data file.
 /// Thread-safety: a pure function; the source is thread-safe as BrickSource requires.
 std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayout& layout = {});
 

@@ -20,7 +20,9 @@ namespace resoct {
 /// included), Error(unsupported) naming the file and page for other sample layouts,
 /// Error(corrupt) naming the file and page when pages disagree in size or type or a strip or
 /// tile fails to decode or a page claims more pixels than its file can hold,
-/// Error(invalid_argument) for a directory without TIFF files. Thread-safety: a pure function
+/// Error(invalid_argument) for a directory without TIFF files or with an entry that resolves,
+/// through a symbolic link, to a file outside the directory (naming the directory and the
+/// entry). Thread-safety: a pure function
 /// (libtiff messages are captured per file, not through global handlers); the source is
 /// thread-safe as BrickSource requires.
 std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path,
