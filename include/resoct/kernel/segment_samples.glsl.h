@@ -23,6 +23,10 @@
 
 RESOCT_KERNEL_BEGIN
 
+/// Fewest steps to the next decision for which the march enters the loop (fewer: one sample per
+/// pass of the march, the same arithmetic).
+RESOCT_CONST(float, RESOCT_SEGMENT_LOOP_MIN_STEPS, 2.0f);
+
 /// Where a segment's samples stand: the ray parameter t of the current segment's start, its
 /// length seg and midpoint tm, the premultiplied accumulated colour, and the ray's counters.
 struct ResoctMarchState {

@@ -646,7 +646,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       bool single = false;
       RESOCT_IF_FX(RESOCT_EFFECT_ANY | RESOCT_EFFECT_PREINT) {}
       else {
-        single = !skip && seg_values != 0u && (seg_values & (seg_values - 1u)) == 0u;
+        // Worth the loop's entry and exit only for a few samples or more.
+        single = !skip && seg_values != 0u && (seg_values & (seg_values - 1u)) == 0u &&
+                 seg_next - tm >= RESOCT_SEGMENT_LOOP_MIN_STEPS * dt;
       }
       if (single) {
         ResoctMarchState ms;
