@@ -6,7 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/build.sh release
+# Only the renderer and what it links: the tests and benchmarks are built by scripts/test.sh.
+bash scripts/build.sh release resoct-render
 mkdir -p out
 build/release/examples/resoct-render --volume procedural:cells --scene examples/scenes/cells.json \
   --backend cpu --mode residency --converge --width 512 --height 512 \
