@@ -166,6 +166,27 @@ TEST_F(ToolExitCodes, ConvertOutOfMemoryIs3) {
   EXPECT_EQ(entries(), (std::vector<std::string>{"out.rbs"}));
 }
 
+TEST_F(ToolExitCodes, ConvertOnAFullDiskIs1AndLeavesTheOldStore) {
+  // A full disk, as a process file-size limit (RLIMIT_FSIZE, 100 blocks of 512 bytes under
+  // /bin/sh) below the store's size, with SIGXFSZ ignored so that the write fails with EFBIG
+  // instead of killing the tool: an I/O error naming the file and the offset, the temporary
+  // file removed, the old store intact.
+  put("out.rbs", kPrevious);
+  const ToolRun r = resoct::test::run_tool_process(
+      dir_.path().string(), "/bin/sh",
+      "-c " + shell_quote("trap '' XFSZ; ulimit -f 100 && exec " + shell_quote(RESOCT_CONVERT) +
+                          " procedural:turbulence:64x64x64 " + shell_quote(dir_.file("out.rbs")) +
+                          " --brick 16 --threads 1"));
+  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+  const std::string last = last_line(r.err);
+  EXPECT_EQ(last.rfind("resoct-convert: error [io]: " + dir_.file("out.rbs") + ".tmp-", 0), 0u)
+      << r.err;
+  EXPECT_NE(last.find(": offset "), std::string::npos) << r.err;
+  EXPECT_NE(last.find(": write failed"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir_.file("out.rbs")), kPrevious);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"out.rbs"}));
+}
+
 TEST_F(ToolExitCodes, InfoExitCodes) {
   const std::string i = RESOCT_INFO;
   put("readme.txt", "hello\n");
