@@ -20,21 +20,11 @@
 #include "test_brick_store_util.hpp"
 
 using namespace resoct;
+using resoct::test::fast_http_options;
 using resoct::test::HttpTestServer;
 using resoct::test::TempDir;
 
 namespace {
-
-HttpOptions fast_options() {
-  HttpOptions o;
-  o.connect_timeout_ms = 1000;
-  o.total_timeout_ms = 2000;
-  o.low_speed_time_s = 1;
-  o.retries = 2;
-  o.backoff_initial_ms = 10;
-  o.backoff_max_ms = 40;
-  return o;
-}
 
 class HttpRedirectTest : public ::testing::Test {
  protected:
@@ -48,7 +38,7 @@ class HttpRedirectTest : public ::testing::Test {
     server_ =
         std::make_unique<HttpTestServer>(HttpTestServer::default_script(), dir_.path().string());
   }
-  HttpStore store(const std::string& mode, HttpOptions o = fast_options()) {
+  HttpStore store(const std::string& mode, HttpOptions o = fast_http_options()) {
     return HttpStore(parse_url_map(server_->base(mode)), o);
   }
   std::string url(const std::string& mode) const { return server_->base(mode) + "/blob.bin"; }
@@ -98,7 +88,7 @@ TEST_F(HttpRedirectTest, RedirectsLeavingTheOriginAreRefusedNamingUrlAndTarget) 
 }
 
 TEST_F(HttpRedirectTest, RedirectOriginsAllowListsFurtherHosts) {
-  HttpOptions o = fast_options();
+  HttpOptions o = fast_http_options();
   o.redirect_origins = {"http://LOCALHOST:" + port() + "/any/path/is/ignored"};
   HttpStore s = store("redirect-host", o);
   const auto whole = s.get("blob.bin", 1 << 20);

@@ -20,6 +20,7 @@
 #include "test_brick_store_util.hpp"
 
 using namespace resoct;
+using resoct::test::fast_http_options;
 using resoct::test::HttpTestServer;
 using resoct::test::TempDir;
 
@@ -37,17 +38,6 @@ void write_file(const std::string& path, const std::vector<std::byte>& b) {
   out.write(reinterpret_cast<const char*>(b.data()), std::streamsize(b.size()));
 }
 
-HttpOptions fast_options() {
-  HttpOptions o;
-  o.connect_timeout_ms = 1000;
-  o.total_timeout_ms = 2000;
-  o.low_speed_time_s = 1;
-  o.retries = 2;
-  o.backoff_initial_ms = 10;
-  o.backoff_max_ms = 40;
-  return o;
-}
-
 class HttpStoreTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -58,18 +48,18 @@ class HttpStoreTest : public ::testing::Test {
     server_ =
         std::make_unique<HttpTestServer>(HttpTestServer::default_script(), dir_.path().string());
   }
-  HttpStore store(const std::string& mode, HttpOptions o = fast_options()) {
+  HttpStore store(const std::string& mode, HttpOptions o = fast_http_options()) {
     return HttpStore(parse_url_map(server_->base(mode)), o);
   }
   nlohmann::json server_stats() {
     HttpStore s(parse_url_map("http://127.0.0.1:" + std::to_string(server_->port())),
-                fast_options());
+                fast_http_options());
     auto b = s.get("_stats", 1 << 20);
     return nlohmann::json::parse(std::string(reinterpret_cast<const char*>(b->data()), b->size()));
   }
   void reset_server() {
     HttpStore s(parse_url_map("http://127.0.0.1:" + std::to_string(server_->port())),
-                fast_options());
+                fast_http_options());
     ASSERT_TRUE(s.get("_reset", 1 << 20).has_value());
   }
 
@@ -218,7 +208,7 @@ TEST_F(HttpStoreTest, GivesUpAfterTheConfiguredRetries) {
 }
 
 TEST_F(HttpStoreTest, StalledServerFailsWithinTheTimeout) {
-  HttpOptions o = fast_options();
+  HttpOptions o = fast_http_options();
   o.total_timeout_ms = 1000;
   o.retries = 1;
   HttpStore s = store("stall", o);
@@ -256,7 +246,7 @@ TEST_F(HttpStoreTest, RoutesKeysToDifferentServers) {
   const auto other_chunk = random_bytes(500, 9);
   write_file(other.file("0/1.2.3"), other_chunk);
   HttpTestServer second(HttpTestServer::default_script(), other.path().string());
-  HttpStore s(parse_url_map(server_->base("ok") + ",0=" + second.base("ok")), fast_options());
+  HttpStore s(parse_url_map(server_->base("ok") + ",0=" + second.base("ok")), fast_http_options());
   auto chunk = s.get("0/1.2.3", 1 << 20);
   ASSERT_TRUE(chunk.has_value());
   EXPECT_TRUE(*chunk == other_chunk);
@@ -272,7 +262,7 @@ TEST(HttpStoreRefused, ConnectionRefusedIsAnIoErrorNamingTheUrl) {
     HttpTestServer s(HttpTestServer::default_script(), d.path().string());
     port = s.port();
   }  // the server is gone: nothing listens on the port any more
-  HttpOptions o = fast_options();
+  HttpOptions o = fast_http_options();
   o.retries = 1;
   HttpStore s(parse_url_map("http://127.0.0.1:" + std::to_string(port) + "/ok"), o);
   EXPECT_RESOCT_ERROR(s.get("x", 10), ErrorCode::io,

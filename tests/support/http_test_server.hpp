@@ -16,6 +16,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "resoct/http_store.hpp"
+
 namespace resoct::test {
 
 class HttpTestServer {
@@ -93,5 +95,18 @@ class HttpTestServer {
   int stdin_fd_ = -1;
   int port_ = 0;
 };
+
+/// HTTP options for tests against HttpTestServer: short timeouts and backoff, two retries, so
+/// that failure cases end in seconds.
+inline HttpOptions fast_http_options() {
+  HttpOptions o;
+  o.connect_timeout_ms = 1000;
+  o.total_timeout_ms = 2000;
+  o.low_speed_time_s = 1;
+  o.retries = 2;
+  o.backoff_initial_ms = 10;
+  o.backoff_max_ms = 40;
+  return o;
+}
 
 }  // namespace resoct::test
