@@ -27,37 +27,24 @@ RESOCT_KERNEL_BEGIN
 /// pass of the march, the same arithmetic).
 RESOCT_CONST(float, RESOCT_SEGMENT_LOOP_MIN_STEPS, 2.0f);
 
-/// Where a segment's samples stand: the ray parameter t of the current segment's start, its
-/// length seg and midpoint tm, the premultiplied accumulated colour, and the ray's counters.
-struct ResoctMarchState {
-  float t;
-  float seg;
-  float tm;
-  vec4 acc;
-  uint samples;
-  uint brick_accesses;
-  uint iterations;
-  float marched;
-};
-
-/// Samples `src` (RESOCT_CH_VALUE) from the state's current sample while its midpoint lies
-/// before `seg_next`. Returns true when the ray saturated (early termination); otherwise the
-/// state holds the next sample, which the march must see first: the ray's end, the iteration
-/// cap, or a new decision. Counts samples, brick accesses, iterations and marched length as the
-/// march's per-sample path does.
+/// Samples `src` (RESOCT_CH_VALUE) from the sample at `tm` (segment [t, t + seg)) while its
+/// midpoint lies before `seg_next`. Returns true when the ray saturated (early termination);
+/// otherwise `t` is the start of the next sample, which the march must see first: the ray's end,
+/// the iteration cap, or a new decision. `acc` is the premultiplied accumulated colour; samples,
+/// brick accesses, iterations and marched length are counted in `stats` as the march's
+/// per-sample path counts them.
 RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src, float dt,
-                                           float t_exit, float seg_next,
-                                           RESOCT_INOUT(ResoctMarchState) m) {
-  // Local copies: in C++ the references could alias nothing here, but locals make it plain to
-  // the compiler (and cost nothing in GLSL).
-  float t = m.t;
-  float seg = m.seg;
-  float tm = m.tm;
-  vec4 acc = m.acc;
-  uint samples = m.samples;
-  uint accesses = m.brick_accesses;
-  uint iterations = m.iterations;
-  float marched = m.marched;
+                                           float t_exit, float seg_next, float seg, float tm,
+                                           RESOCT_INOUT(float) t, RESOCT_INOUT(vec4) acc,
+                                           RESOCT_INOUT(ResoctRayStats) stats) {
+  // The loop's state in locals, written back once: in C++ the references could alias nothing
+  // here, but locals make it plain to the compiler (and cost nothing in GLSL).
+  float t_now = t;
+  vec4 a = acc;
+  uint samples = stats.samples;
+  uint accesses = stats.brick_accesses;
+  uint iterations = stats.iterations;
+  float marched = stats.marched;
   bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
   bool saturated = false;
   for (;;) {
@@ -74,27 +61,25 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
     // resoct_mix_result of this one channel: its colour premultiplied (0 where alpha is 0).
     vec4 sample_pm =
         alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha) : vec4(0.0f);
-    acc = resoct_composite(acc, sample_pm);
-    if (resoct_saturated(acc, f.ert_opacity)) {
+    a = resoct_composite(a, sample_pm);
+    if (resoct_saturated(a, f.ert_opacity)) {
       saturated = true;
       break;
     }
     marched = marched + seg;
-    t = resoct_advance_t(t, seg);
-    if (!(t_exit - t > RESOCT_SEGMENT_EPS * dt) || iterations >= f.max_iterations) break;
-    seg = resoct_segment_length(t, dt, t_exit);
-    tm = t + 0.5f * seg;
+    t_now = resoct_advance_t(t_now, seg);
+    if (!(t_exit - t_now > RESOCT_SEGMENT_EPS * dt) || iterations >= f.max_iterations) break;
+    seg = resoct_segment_length(t_now, dt, t_exit);
+    tm = t_now + 0.5f * seg;
     if (!(tm < seg_next)) break;
     iterations = iterations + 1u;
   }
-  m.t = t;
-  m.seg = seg;
-  m.tm = tm;
-  m.acc = acc;
-  m.samples = samples;
-  m.brick_accesses = accesses;
-  m.iterations = iterations;
-  m.marched = marched;
+  t = t_now;
+  acc = a;
+  stats.samples = samples;
+  stats.brick_accesses = accesses;
+  stats.iterations = iterations;
+  stats.marched = marched;
   return saturated;
 }
 

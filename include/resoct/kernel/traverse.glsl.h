@@ -39,6 +39,7 @@
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/node_class.glsl.h"
+#include "resoct/kernel/node_run.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/preintegration.glsl.h"
@@ -64,80 +65,6 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.marched = 0.0f;
   st.gradient_evals = 0u;
   st.shadow_rays = 0u;
-}
-
-/// Most nodes beyond the current one that one residency decision classifies ahead along the ray.
-RESOCT_CONST(uint, RESOCT_NODE_RUN_LENGTH, 8u);
-
-/// Whether every live channel's own record at `node` has the class `cls` (EMPTY or VISIBLE).
-RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint node,
-                                     uint cls) {
-  for (uint c = 0u; c < n; ++c) {
-    if (((live >> c) & 1u) == 0u) continue;
-    if (resoct_node_class(node, resoct_read_slot(bank + c), f.node_slot_count) != cls) {
-      return false;
-    }
-  }
-  return true;
-}
-
-/// The end of a run of nodes of one class along the ray. The run starts at the node of depth
-/// `depth` with coordinates `coord` and level-0 corner `lo`, which holds the sample at (cell,
-/// frac) and which the ray leaves at `node_end` (t relative to the sample); the nodes the ray
-/// enters next continue it while every live channel's own record has the class `cls`: EMPTY (a
-/// skip goes on through them) or VISIBLE (crossing into them is no decision). A node's metadata
-/// covers its subtree, so a node's own class for a channel is the class the descent would find
-/// there (no ancestor of a visible node is empty for the channel; an empty node's descendants are
-/// all empty). The run stops at the first other node (one without metadata included), at the
-/// volume's faces or the integer box [box_lo, box_hi), after RESOCT_NODE_RUN_LENGTH nodes, and
-/// where the ray leaves a node through an edge or a corner. Which face the ray leaves through is
-/// decided by comparing products, which both backends round alike (a quotient may differ in its
-/// last bit on a device), so that the nodes visited are the same on every backend; the exits
-/// themselves are computed from the sample's exact position, as the current node's is.
-RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint cls,
-                                    uint depth, uvec3 coord, ivec3 lo, ivec3 cell, vec3 frac,
-                                    vec3 dir_vox, float node_end, ivec3 box_lo, ivec3 box_hi,
-                                    RESOCT_INOUT(ResoctRayStats) stats) {
-  ResoctDepthInfo D = resoct_read_depth(depth);
-  ivec3 ne = ivec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
-  uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
-  uvec3 lg = resoct_depth_count_log2(D);
-  vec3 ad = abs(dir_vox);
-  float end = node_end;
-  for (uint i = 0u; i < RESOCT_NODE_RUN_LENGTH; ++i) {
-    // Distance to the far face per axis, in level-0 voxels (infinite where the ray is parallel):
-    // the exit along an axis is dist / |dir|, compared across axes as dist_a * |dir_b|.
-    vec3 rel = resoct_relative_origin(cell, frac, lo);
-    vec3 dist = vec3(dir_vox.x > 0.0f ? float(ne.x) - rel.x : rel.x,
-                     dir_vox.y > 0.0f ? float(ne.y) - rel.y : rel.y,
-                     dir_vox.z > 0.0f ? float(ne.z) - rel.z : rel.z);
-    bool px = ad.x < RESOCT_RAY_PARALLEL_EPS;
-    bool py = ad.y < RESOCT_RAY_PARALLEL_EPS;
-    bool pz = ad.z < RESOCT_RAY_PARALLEL_EPS;
-    RESOCT_PRECISE float xy = dist.x * ad.y;
-    RESOCT_PRECISE float yx = dist.y * ad.x;
-    RESOCT_PRECISE float xz = dist.x * ad.z;
-    RESOCT_PRECISE float zx = dist.z * ad.x;
-    RESOCT_PRECISE float yz = dist.y * ad.z;
-    RESOCT_PRECISE float zy = dist.z * ad.y;
-    // Axis a is the unique first exit when its exit is strictly before each other axis's.
-    bool x_first = !px && (py || xy < yx) && (pz || xz < zx);
-    bool y_first = !py && (px || yx < xy) && (pz || yz < zy);
-    bool z_first = !pz && (px || zx < xz) && (py || zy < yz);
-    if (!x_first && !y_first && !z_first) break;
-    uint axis = x_first ? 0u : (y_first ? 1u : 2u);
-    float d = axis == 0u ? dir_vox.x : (axis == 1u ? dir_vox.y : dir_vox.z);
-    int dstep = d > 0.0f ? 1 : -1;
-    // Unsigned: stepping below 0 wraps past the count.
-    coord[axis] = uint(int(coord[axis]) + dstep);
-    if (coord[axis] >= count[axis]) break;
-    lo[axis] = lo[axis] + dstep * ne[axis];
-    if (any(lessThan(lo, box_lo)) || any(greaterThan(lo + ne, box_hi))) break;
-    stats.nodes = stats.nodes + 1u;
-    if (!resoct_node_class_all(f, bank, n, live, resoct_node_index(depth, coord, lg), cls)) break;
-    end = max(end, resoct_box_exit_t(cell, frac, dir_vox, lo, lo + ne));
-  }
-  return end;
 }
 
 /// Renders one pixel with the effects of RESOCT_EFFECTS (kernel/effects.glsl.h): the
@@ -651,22 +578,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                  seg_next - tm >= RESOCT_SEGMENT_LOOP_MIN_STEPS * dt;
       }
       if (single) {
-        ResoctMarchState ms;
-        ms.t = t;
-        ms.seg = seg;
-        ms.tm = tm;
-        ms.acc = acc;
-        ms.samples = stats.samples;
-        ms.brick_accesses = stats.brick_accesses;
-        ms.iterations = stats.iterations;
-        ms.marched = stats.marched;
-        stop = resoct_segment_samples(f, src[findLSB(seg_values)], dt, t_exit, seg_next, ms);
-        t = ms.t;
-        acc = ms.acc;
-        stats.samples = ms.samples;
-        stats.brick_accesses = ms.brick_accesses;
-        stats.iterations = ms.iterations;
-        stats.marched = ms.marched;
+        stop = resoct_segment_samples(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm, t,
+                                      acc, stats);
         if (stop) break;
         continue;
       }
