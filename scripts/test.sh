@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# The README's second command: installs what is missing, checks formatting, builds the release
-# preset and runs the whole default test suite (opt-in labels "heavy" and "fuzz" excluded).
+# The README's second command: installs what is missing (Debian packages, then the npm test
+# helpers), checks formatting, builds the release preset and runs the whole default test suite
+# (opt-in labels "heavy" and "fuzz" excluded).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+bash scripts/install-test-tools.sh
 bash scripts/check-format.sh
 bash scripts/build.sh release
 # install-deps.sh installs lavapipe, so Vulkan must work here: a Vulkan test that would skip for
