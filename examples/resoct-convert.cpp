@@ -37,6 +37,7 @@ using namespace resoct;
 using namespace resoct::tools;
 
 constexpr const char* kTool = "resoct-convert";
+constexpr const char* kRawTypes = "u8, u16, f32, i8, i16, i32, u32, f64";
 
 struct Args {
   std::string input, output;
@@ -112,13 +113,20 @@ std::unique_ptr<BrickSource> open_raw(const Args& a, const CLI::App& app,
                             "required for raw input '" + a.input + "' (e.g. 256x256x128)");
   }
   if (app.count("--type") == 0) {
-    throw invalid_parameter("--type", "required for raw input '" + a.input + "' (u8, u16, f32)");
+    throw invalid_parameter("--type",
+                            "required for raw input '" + a.input + "' (" + kRawTypes + ")");
   }
   RawVolumeOptions o;
   o.extent = parse_dims(a.dims, "--dims");
-  const auto type = parse_voxel_type(a.type);
-  if (!type) throw invalid_parameter("--type", "expected u8, u16 or f32, got '" + a.type + "'");
-  o.type = *type;
+  const auto type = parse_data_type(a.type);
+  if (!type) {
+    throw invalid_parameter("--type",
+                            std::string("expected one of ") + kRawTypes + ", got '" + a.type + "'");
+  }
+  o.data_type = *type;
+  if (!data_mapping(*type).exact) {
+    std::fprintf(stderr, "%s: values of type %s\n", kTool, describe_mapping(*type).c_str());
+  }
   const auto endian = parse_endian(a.endian);
   if (!endian) {
     throw invalid_parameter("--endian", "expected little or big, got '" + a.endian + "'");
@@ -131,7 +139,7 @@ std::unique_ptr<BrickSource> open_raw(const Args& a, const CLI::App& app,
     o.ranges.assign(a.channels, parse_range(a.range, "--range"));
   }
   DenseVolume volume = open_raw_volume(a.input, o);
-  if (o.type == VoxelType::f32 && o.ranges.empty()) {
+  if (volume.desc().type == VoxelType::f32 && o.ranges.empty()) {
     VolumeDesc desc = volume.desc();
     desc.ranges = scan_f32_ranges(volume);
     std::fprintf(stderr, "%s: f32 value range of channel 0 taken from the data: [%g, %g]\n", kTool,
@@ -161,7 +169,7 @@ void print_summary(const Args& a, const BrickSource& src, const StoreSummary& s,
       "(level 0) in %.2f s = %.1f MB/s, %u thread(s).\n",
       a.output.c_str(), static_cast<unsigned long long>(v.extent.x),
       static_cast<unsigned long long>(v.extent.y), static_cast<unsigned long long>(v.extent.z),
-      std::string(to_string(v.type)).c_str(), v.channels, s.stats.levels.size(),
+      std::string(to_string(v.file_type())).c_str(), v.channels, s.stats.levels.size(),
       static_cast<unsigned long long>(t.brick_count),
       static_cast<unsigned long long>(t.constant_bricks),
       static_cast<unsigned long long>(t.empty_bricks), format_bytes(t.uncompressed_bytes).c_str(),
@@ -249,7 +257,10 @@ int main(int argc, char** argv) {
   app.add_option("output", a.output, "brick store to write (replaced atomically)")->required();
   auto* raw = "Raw input";
   app.add_option("--dims", a.dims, "raw: voxels per axis, WxHxD")->group(raw);
-  app.add_option("--type", a.type, "raw: voxel type u8, u16 or f32")->group(raw);
+  app.add_option("--type", a.type,
+                 std::string("raw: value type ") + kRawTypes +
+                     " (i8/i16 kept exactly as u8/u16 plus an offset; i32, u32, f64 as f32)")
+      ->group(raw);
   app.add_option("--endian", a.endian, "raw: byte order little or big (default little)")
       ->group(raw);
   app.add_option("--spacing", a.spacing, "raw: voxel size X,Y,Z (default 1,1,1)")->group(raw);
@@ -257,8 +268,8 @@ int main(int argc, char** argv) {
       ->group(raw);
   app.add_option("--offset", a.offset, "raw: header bytes to skip (default 0)")->group(raw);
   app.add_option("--range", a.range,
-                 "raw: value range LO,HI of every channel (default: the type's full range; for "
-                 "f32 the data's finite min/max)")
+                 "raw: value range LO,HI of every channel in the file's units (default: the "
+                 "type's full range; for f32, i32, u32, f64 the data's finite min/max)")
       ->group(raw);
   app.add_option("--brick", a.brick, "core brick size N or NxNxN (4..1024, default 32)");
   app.add_option("--halo", a.halo, "halo voxels per side (0..4, default 1)");

@@ -75,13 +75,19 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
   j["kind"] = std::string(to_string(kind));
   json ranges = json::array();
   for (std::uint32_t c = 0; c < v.channels; ++c) {
-    ranges.push_back(json::array({v.range(c).lo, v.range(c).hi}));
+    ranges.push_back(json::array({v.data_range(c).lo, v.data_range(c).hi}));
   }
+  const DataMapping mapping = data_mapping(v.file_type());
+  // "type" is the file's value type and "ranges" are in its units; "stored_type" and
+  // "value_offset" say how the cache keeps it, "exact" whether that loses nothing.
   j["volume"] = {{"extent", vec(v.extent)},
                  {"spacing", vec(v.spacing)},
                  {"physical_size", vec(physical_size(v))},
                  {"channels", v.channels},
-                 {"type", std::string(to_string(v.type))},
+                 {"type", std::string(to_string(v.file_type()))},
+                 {"stored_type", std::string(to_string(v.type))},
+                 {"value_offset", mapping.offset},
+                 {"exact", mapping.exact},
                  {"ranges", ranges}};
   j["layout"] = {{"brick_size", vec(h.layout().brick_size)},
                  {"halo", h.layout().halo},
@@ -119,7 +125,7 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
 std::string ranges_text(const VolumeDesc& v) {
   auto one = [&](std::uint32_t c) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "[%g, %g]", v.range(c).lo, v.range(c).hi);
+    std::snprintf(buf, sizeof buf, "[%g, %g]", v.data_range(c).lo, v.data_range(c).hi);
     return std::string(buf);
   };
   bool same = true;
@@ -140,7 +146,7 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
   const glm::dvec3 phys = physical_size(v);
   std::printf("%s\n", src.name().c_str());
   std::printf("  volume   %s voxels, %u channel(s), %s, spacing %g x %g x %g (size %g x %g x %g)\n",
-              xyz(v.extent).c_str(), v.channels, std::string(to_string(v.type)).c_str(),
+              xyz(v.extent).c_str(), v.channels, describe_mapping(v.file_type()).c_str(),
               v.spacing.x, v.spacing.y, v.spacing.z, phys.x, phys.y, phys.z);
   std::printf("  ranges   %s\n", ranges_text(v).c_str());
   std::printf("  bricks   %s core, halo %u, %s padded (%s each)\n", xyz(lay.brick_size).c_str(),

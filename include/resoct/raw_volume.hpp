@@ -35,6 +35,11 @@ struct RawVolumeOptions {
   std::uint32_t channels = 1;      ///< 1..kMaxChannels
   std::uint64_t offset = 0;        ///< header bytes skipped before the first voxel
   std::vector<ValueRange> ranges;  ///< one per channel, or empty for default_range(type)
+  /// The file's value type, any DataType; when set, `type` is ignored. Values of a type that is
+  /// not a VoxelType (i8, i16, i32, u32, f64) are kept as data_mapping(*data_type) says
+  /// (voxel_type.hpp) in a copy, and `ranges` are in the file's units (an int16 CT window
+  /// [-1000, 2000]).
+  std::optional<DataType> data_type;
 };
 
 /// Opens a raw volume file as a DenseVolume.

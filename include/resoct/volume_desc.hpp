@@ -1,8 +1,10 @@
 #pragma once
 /// \file
-/// What a volume is, independent of how it is bricked: extent, spacing, channels, voxel type.
+/// What a volume is, independent of how it is bricked: extent, spacing, channels, voxel type
+/// (and the file's own value type when it is kept mapped).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,9 +23,20 @@ struct VolumeDesc {
   std::uint32_t channels = 1;      ///< 1..kMaxChannels
   VoxelType type = VoxelType::u8;  ///< stored natively
   std::vector<ValueRange> ranges;  ///< one per channel; empty means default_range(type) for all
+  /// The type of the values in the file when it is not `type` itself (int16 CT kept as u16,
+  /// float64 kept as f32: data_mapping()). Voxels, `ranges` and everything downstream are in
+  /// stored units (value + data_mapping(data_type).offset); data_range() gives the file's units.
+  std::optional<DataType> data_type;
 
-  /// Range of channel c (falls back to default_range(type) when `ranges` is empty).
+  /// Range of channel c (falls back to default_range(type) when `ranges` is empty), in stored
+  /// units.
   ValueRange range(std::uint32_t c) const;
+  /// The file's value type: data_type, or `type`'s own.
+  DataType file_type() const noexcept { return data_type.value_or(data_type_of(type)); }
+  /// Stored value minus file value: 32768 for i16, 128 for i8, else 0.
+  double value_offset() const noexcept { return data_mapping(file_type()).offset; }
+  /// range(c) in the file's units (an int16 CT channel reads [-1024, 3071], not [31744, 35839]).
+  ValueRange data_range(std::uint32_t c) const;
 
   /// Level-0 voxels in one channel; throws Error(overflow) if it exceeds 64 bits.
   std::uint64_t voxel_count() const;

@@ -87,7 +87,7 @@ std::vector<std::byte> encode_header(const StoreHeader& h) {
   put_u64(b, hdr::metadata_size, h.metadata_size);
   put_u64(b, hdr::metadata_raw_size, h.metadata_raw_size);
   put_u32(b, hdr::metadata_crc, h.metadata_crc);
-  put_u32(b, hdr::reserved, 0);
+  put_u32(b, hdr::data_type, h.volume.data_type ? std::uint32_t(*h.volume.data_type) : 0u);
   for (std::uint32_t c = 0; c < channels; ++c) {
     const ValueRange r = h.volume.range(c);
     put_f64(b, hdr::ranges + 16u * c, r.lo);
@@ -155,9 +155,6 @@ StoreHeader decode_header(const RandomAccessFile& file) {
     throw fail(ErrorCode::unsupported, hdr::flags,
                "unknown header flags " + std::to_string(h.flags & ~kKnownFlags));
   }
-  if (get_u32(b, hdr::reserved) != 0) {
-    throw fail(ErrorCode::corrupt, hdr::reserved, "reserved header field is not zero");
-  }
   const std::uint32_t channels = get_u32(b, hdr::channels);
   if (channels == 0 || channels > kMaxChannels) {
     throw fail(ErrorCode::corrupt, hdr::channels,
@@ -175,6 +172,15 @@ StoreHeader decode_header(const RandomAccessFile& file) {
     throw fail(ErrorCode::corrupt, hdr::voxel_type, "unknown voxel type " + std::to_string(type));
   }
   h.volume.type = VoxelType(type);
+  if (const std::uint32_t dt = get_u32(b, hdr::data_type); dt != 0) {
+    if (dt < std::uint32_t(DataType::i8) || dt > std::uint32_t(DataType::f64) ||
+        data_mapping(DataType(dt)).stored != h.volume.type) {
+      throw fail(ErrorCode::corrupt, hdr::data_type,
+                 "data type " + std::to_string(dt) + " is not one kept as voxel type " +
+                     std::string(to_string(h.volume.type)));
+    }
+    h.volume.data_type = DataType(dt);
+  }
   const char* axis = "xyz";
   for (int i = 0; i < 3; ++i) {
     h.volume.extent[i] = get_u64(b, hdr::extent + 8u * i);

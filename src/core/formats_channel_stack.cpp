@@ -15,10 +15,11 @@ VolumeDesc stacked_desc(const std::vector<std::shared_ptr<const BrickSource>>& s
   d.ranges.clear();
   for (const auto& s : sources) {
     const VolumeDesc& v = s->volume();
-    if (v.extent != first.volume().extent || v.type != first.volume().type ||
+    // One value offset for the whole volume: an i16 channel cannot sit beside a u16 one.
+    if (v.extent != first.volume().extent || v.file_type() != first.volume().file_type() ||
         !(s->hierarchy().layout() == first.hierarchy().layout())) {
       throw invalid_parameter("sources", "'" + s->name() + "' differs from '" + first.name() +
-                                             "' in extent, voxel type or brick layout");
+                                             "' in extent, value type or brick layout");
     }
     if (d.channels + v.channels > kMaxChannels) {
       throw invalid_parameter("sources", "more than " + std::to_string(kMaxChannels) + " channels");

@@ -14,22 +14,13 @@ namespace resoct {
 
 namespace {
 
-detail::SampleType sample_type(NiftiDatatype d) {
-  switch (d) {
-    case NiftiDatatype::u8: return detail::SampleType::u8;
-    case NiftiDatatype::i16: return detail::SampleType::i16;
-    case NiftiDatatype::u16: return detail::SampleType::u16;
-    case NiftiDatatype::f32: return detail::SampleType::f32;
-  }
-  return detail::SampleType::u8;
-}
-
 VolumeDesc describe(const NiftiHeader& h) {
   VolumeDesc d;
   d.extent = h.extent();
   d.spacing = h.spacing();
   d.channels = h.volumes();
-  d.type = detail::voxel_type_for(sample_type(h.datatype), h.scaled());
+  d.type = detail::voxel_type_for(h.datatype, h.scaled());
+  if (!h.scaled() && data_type_of(d.type) != h.datatype) d.data_type = h.datatype;
   return d;
 }
 
@@ -42,9 +33,8 @@ DenseVolume decode(const NiftiHeader& h, std::span<const std::byte> file, const 
   }
   const VolumeDesc d = describe(h);
   std::vector<std::byte> voxels(std::size_t(d.voxel_count() * d.channels * voxel_size(d.type)));
-  detail::convert_samples(file.subspan(std::size_t(h.vox_offset), std::size_t(need)),
-                          sample_type(h.datatype), h.endian, h.scaled(), h.scl_slope, h.scl_inter,
-                          voxels);
+  detail::convert_samples(file.subspan(std::size_t(h.vox_offset), std::size_t(need)), h.datatype,
+                          h.endian, h.scaled(), h.scl_slope, h.scl_inter, voxels);
   return DenseVolume::from_bytes(d, std::move(voxels));
 }
 
@@ -78,7 +68,7 @@ std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayo
   }
   file.read_at(0, head);
   const NiftiHeader h = parse_nifti_header(head, path);
-  if (detail::samples_are_voxels(sample_type(h.datatype), h.endian, h.scaled())) {
+  if (detail::samples_are_voxels(h.datatype, h.endian, h.scaled())) {
     // Stored voxels are resoct voxels: map the file instead of copying it.
     const VolumeDesc d = describe(h);
     RawVolumeOptions r;

@@ -72,13 +72,7 @@ bool NiftiHeader::scaled() const noexcept {
 }
 
 std::size_t NiftiHeader::stored_voxel_bytes() const noexcept {
-  switch (datatype) {
-    case NiftiDatatype::u8: return 1;
-    case NiftiDatatype::i16:
-    case NiftiDatatype::u16: return 2;
-    case NiftiDatatype::f32: return 4;
-  }
-  return 1;
+  return data_size(datatype);
 }
 
 std::uint64_t NiftiHeader::data_bytes() const {
@@ -145,18 +139,22 @@ NiftiHeader parse_nifti_header(std::span<const std::byte> bytes, std::string_vie
   }
   const std::int16_t datatype = r.get<std::int16_t>(70);
   const std::int16_t bitpix = r.get<std::int16_t>(72);
-  int want_bits = 0;
   switch (datatype) {
-    case 2: h.datatype = NiftiDatatype::u8, want_bits = 8; break;
-    case 4: h.datatype = NiftiDatatype::i16, want_bits = 16; break;
-    case 512: h.datatype = NiftiDatatype::u16, want_bits = 16; break;
-    case 16: h.datatype = NiftiDatatype::f32, want_bits = 32; break;
+    case 2: h.datatype = DataType::u8; break;
+    case 256: h.datatype = DataType::i8; break;
+    case 4: h.datatype = DataType::i16; break;
+    case 512: h.datatype = DataType::u16; break;
+    case 8: h.datatype = DataType::i32; break;
+    case 768: h.datatype = DataType::u32; break;
+    case 16: h.datatype = DataType::f32; break;
+    case 64: h.datatype = DataType::f64; break;
     default:
       throw field_error(ErrorCode::unsupported, location, 70, "datatype",
                         std::to_string(datatype) +
-                            " is not supported (2 = uint8, 4 = int16, 512 = uint16, 16 = float32)");
+                            " is not supported (2 = uint8, 256 = int8, 4 = int16, 512 = uint16, "
+                            "8 = int32, 768 = uint32, 16 = float32, 64 = float64)");
   }
-  if (bitpix != want_bits) {
+  if (bitpix != std::int16_t(8 * data_size(h.datatype))) {
     throw field_error(
         ErrorCode::corrupt, location, 72, "bitpix",
         std::to_string(bitpix) + " disagrees with datatype " + std::to_string(datatype));

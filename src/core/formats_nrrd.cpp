@@ -20,16 +20,6 @@ namespace {
 /// Longest header read (a header is text of a few hundred bytes; this bounds hostile files).
 constexpr std::uint64_t kMaxHeader = std::uint64_t(1) << 20;
 
-detail::SampleType sample_type(NrrdType t) {
-  switch (t) {
-    case NrrdType::u8: return detail::SampleType::u8;
-    case NrrdType::i16: return detail::SampleType::i16;
-    case NrrdType::u16: return detail::SampleType::u16;
-    case NrrdType::f32: return detail::SampleType::f32;
-  }
-  return detail::SampleType::u8;
-}
-
 /// Offset just past `lines` newlines starting at `from`.
 std::uint64_t skip_lines(const ReadFile& f, std::uint64_t from, std::uint64_t lines) {
   std::uint64_t pos = from;
@@ -95,8 +85,9 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   d.extent = h.extent();
   d.spacing = h.spacing;
   d.channels = h.channels();
-  const auto st = sample_type(h.type);
+  const DataType st = h.type;
   d.type = detail::voxel_type_for(st, false);
+  if (data_type_of(d.type) != st) d.data_type = st;
   const std::uint64_t need = h.data_bytes();
   PyramidSourceOptions o;
   o.ranges_from_data = true;
@@ -154,7 +145,7 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
     stored.resize(std::size_t(need));
     data.read_at(offset, stored);
   }
-  std::vector<std::byte> voxels(std::size_t(need / detail::sample_bytes(st) * voxel_size(d.type)));
+  std::vector<std::byte> voxels(std::size_t(need / data_size(st) * voxel_size(d.type)));
   detail::convert_samples(stored, st, h.endian, false, 1.0, 0.0, voxels);
   if (h.channel_axis == 0 && d.channels > 1) {
     voxels = deinterleave(voxels, d.channels, voxel_size(d.type));

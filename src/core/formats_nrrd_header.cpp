@@ -2,6 +2,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "resoct/error.hpp"
 #include "resoct/formats/nrrd.hpp"
@@ -73,20 +74,44 @@ class Parser {
   std::string_view location_;
 };
 
-NrrdType parse_type(const Parser& p, const Line& l) {
-  const std::string v(l.value);
-  if (v == "uchar" || v == "unsigned char" || v == "uint8" || v == "uint8_t") return NrrdType::u8;
-  if (v == "short" || v == "short int" || v == "signed short" || v == "signed short int" ||
-      v == "int16" || v == "int16_t") {
-    return NrrdType::i16;
+DataType parse_type(const Parser& p, const Line& l) {
+  // The NRRD format's type names (teem's airEnum) and the value type each denotes.
+  static constexpr std::pair<std::string_view, DataType> kNames[] = {
+      {"signed char", DataType::i8},
+      {"int8", DataType::i8},
+      {"int8_t", DataType::i8},
+      {"uchar", DataType::u8},
+      {"unsigned char", DataType::u8},
+      {"uint8", DataType::u8},
+      {"uint8_t", DataType::u8},
+      {"short", DataType::i16},
+      {"short int", DataType::i16},
+      {"signed short", DataType::i16},
+      {"signed short int", DataType::i16},
+      {"int16", DataType::i16},
+      {"int16_t", DataType::i16},
+      {"ushort", DataType::u16},
+      {"unsigned short", DataType::u16},
+      {"unsigned short int", DataType::u16},
+      {"uint16", DataType::u16},
+      {"uint16_t", DataType::u16},
+      {"int", DataType::i32},
+      {"signed int", DataType::i32},
+      {"int32", DataType::i32},
+      {"int32_t", DataType::i32},
+      {"uint", DataType::u32},
+      {"unsigned int", DataType::u32},
+      {"uint32", DataType::u32},
+      {"uint32_t", DataType::u32},
+      {"float", DataType::f32},
+      {"double", DataType::f64},
+  };
+  for (const auto& [name, type] : kNames) {
+    if (l.value == name) return type;
   }
-  if (v == "ushort" || v == "unsigned short" || v == "unsigned short int" || v == "uint16" ||
-      v == "uint16_t") {
-    return NrrdType::u16;
-  }
-  if (v == "float") return NrrdType::f32;
   p.fail(ErrorCode::unsupported, l,
-         "type '" + v + "' is not supported (uint8, int16, uint16, float are)");
+         "type '" + std::string(l.value) +
+             "' is not supported (int8, uint8, int16, uint16, int32, uint32, float, double are)");
 }
 
 bool domain_kind(std::string_view k) {
@@ -110,7 +135,7 @@ std::uint32_t NrrdHeader::channels() const noexcept {
 }
 
 std::size_t NrrdHeader::stored_voxel_bytes() const noexcept {
-  return type == NrrdType::u8 ? 1u : type == NrrdType::f32 ? 4u : 2u;
+  return data_size(type);
 }
 
 std::uint64_t NrrdHeader::data_bytes() const {

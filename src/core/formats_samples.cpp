@@ -2,6 +2,8 @@
 
 #include <bit>
 #include <cstring>
+#include <limits>
+#include <type_traits>
 
 namespace resoct::detail {
 
@@ -19,6 +21,8 @@ T load(const std::byte* p, bool swap) {
   return v;
 }
 
+/// Out is float for scaled and wide values; otherwise the unsigned type of In's width, reached
+/// by adding the mapping's offset (exact: -32768..32767 + 32768 is 0..65535).
 template <typename In, typename Out>
 void convert(std::span<const std::byte> in, bool swap, bool scaled, double slope, double inter,
              std::span<std::byte> out) {
@@ -28,6 +32,8 @@ void convert(std::span<const std::byte> in, bool swap, bool scaled, double slope
     Out o;
     if constexpr (std::is_same_v<Out, float>) {
       o = scaled ? float(slope * double(v) + inter) : float(v);
+    } else if constexpr (std::is_signed_v<In>) {
+      o = Out(std::int32_t(v) - std::int32_t(std::numeric_limits<In>::min()));
     } else {
       o = Out(v);
     }
@@ -37,34 +43,37 @@ void convert(std::span<const std::byte> in, bool swap, bool scaled, double slope
 
 }  // namespace
 
-std::size_t sample_bytes(SampleType t) noexcept {
-  return t == SampleType::u8 ? 1u : t == SampleType::f32 ? 4u : 2u;
+VoxelType voxel_type_for(DataType t, bool scaled) noexcept {
+  return scaled ? VoxelType::f32 : data_mapping(t).stored;
 }
 
-VoxelType voxel_type_for(SampleType t, bool scaled) noexcept {
-  if (scaled || t == SampleType::i16 || t == SampleType::f32) return VoxelType::f32;
-  return t == SampleType::u8 ? VoxelType::u8 : VoxelType::u16;
-}
-
-bool samples_are_voxels(SampleType t, Endian e, bool scaled) noexcept {
-  if (scaled || t == SampleType::i16) return false;
+bool samples_are_voxels(DataType t, Endian e, bool scaled) noexcept {
+  if (scaled || data_type_of(data_mapping(t).stored) != t) return false;
   const bool host_little = std::endian::native == std::endian::little;
-  return t == SampleType::u8 || (e == Endian::little) == host_little;
+  return t == DataType::u8 || (e == Endian::little) == host_little;
 }
 
-void convert_samples(std::span<const std::byte> in, SampleType t, Endian e, bool scaled,
-                     double slope, double inter, std::span<std::byte> out) {
+void convert_samples(std::span<const std::byte> in, DataType t, Endian e, bool scaled, double slope,
+                     double inter, std::span<std::byte> out) {
   const bool swap = (e == Endian::little) != (std::endian::native == std::endian::little);
-  switch (voxel_type_for(t, scaled)) {
-    case VoxelType::u8: convert<std::uint8_t, std::uint8_t>(in, false, false, 0, 0, out); return;
-    case VoxelType::u16: convert<std::uint16_t, std::uint16_t>(in, swap, false, 0, 0, out); return;
-    case VoxelType::f32: break;
+  if (!scaled) {
+    switch (t) {
+      case DataType::u8: convert<std::uint8_t, std::uint8_t>(in, false, false, 0, 0, out); return;
+      case DataType::i8: convert<std::int8_t, std::uint8_t>(in, false, false, 0, 0, out); return;
+      case DataType::u16: convert<std::uint16_t, std::uint16_t>(in, swap, false, 0, 0, out); return;
+      case DataType::i16: convert<std::int16_t, std::uint16_t>(in, swap, false, 0, 0, out); return;
+      default: break;
+    }
   }
   switch (t) {
-    case SampleType::u8: convert<std::uint8_t, float>(in, swap, scaled, slope, inter, out); break;
-    case SampleType::i16: convert<std::int16_t, float>(in, swap, scaled, slope, inter, out); break;
-    case SampleType::u16: convert<std::uint16_t, float>(in, swap, scaled, slope, inter, out); break;
-    case SampleType::f32: convert<float, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::u8: convert<std::uint8_t, float>(in, false, scaled, slope, inter, out); break;
+    case DataType::i8: convert<std::int8_t, float>(in, false, scaled, slope, inter, out); break;
+    case DataType::u16: convert<std::uint16_t, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::i16: convert<std::int16_t, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::i32: convert<std::int32_t, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::u32: convert<std::uint32_t, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::f32: convert<float, float>(in, swap, scaled, slope, inter, out); break;
+    case DataType::f64: convert<double, float>(in, swap, scaled, slope, inter, out); break;
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// Stored samples of single-resolution formats (NIfTI, NRRD) to resoct voxels (internal).
+// Stored samples of the single-resolution formats (NIfTI, NRRD, TIFF, raw) and of zarr chunks to
+// resoct voxels (internal): the one place where data_mapping() is applied to file values.
 
 #include <cstddef>
 #include <cstdint>
@@ -10,21 +11,17 @@
 
 namespace resoct::detail {
 
-/// Sample types these formats store.
-enum class SampleType : std::uint8_t { u8, i16, u16, f32 };
-
-std::size_t sample_bytes(SampleType t) noexcept;
-
-/// The voxel type a stored type becomes: u8 and u16 stay unless `scaled`; i16 and every scaled
-/// type become f32 (no signed type in resoct; f32 holds every i16 and u16 exactly).
-VoxelType voxel_type_for(SampleType t, bool scaled) noexcept;
+/// The voxel type file values of type `t` become: data_mapping(t).stored, or f32 when `scaled`
+/// (NIfTI scl_slope / scl_inter other than the identity).
+VoxelType voxel_type_for(DataType t, bool scaled) noexcept;
 
 /// True when the stored bytes are already resoct voxels (no conversion, host byte order).
-bool samples_are_voxels(SampleType t, Endian e, bool scaled) noexcept;
+bool samples_are_voxels(DataType t, Endian e, bool scaled) noexcept;
 
-/// Converts in.size() / sample_bytes(t) samples of byte order `e` into voxels of
-/// voxel_type_for(t, scaled) in `out` (sized accordingly): v' = slope * v + inter when scaled.
-void convert_samples(std::span<const std::byte> in, SampleType t, Endian e, bool scaled,
-                     double slope, double inter, std::span<std::byte> out);
+/// Converts in.size() / data_size(t) values of byte order `e` into voxels of
+/// voxel_type_for(t, scaled) in `out` (sized accordingly): v' = slope * v + inter when scaled,
+/// else v + data_mapping(t).offset.
+void convert_samples(std::span<const std::byte> in, DataType t, Endian e, bool scaled, double slope,
+                     double inter, std::span<std::byte> out);
 
 }  // namespace resoct::detail

@@ -1,9 +1,11 @@
 #include <algorithm>
+#include <bit>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,6 +13,7 @@
 #include <tiffio.h>
 
 #include "confined_path.hpp"
+#include "formats_samples.hpp"
 #include "resoct/dense_volume.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/pyramid_source.hpp"
@@ -74,6 +77,23 @@ struct PageFormat {
   friend bool operator==(const PageFormat&, const PageFormat&) = default;
 };
 
+/// The value type of a page's samples, or nothing when resoct does not read it.
+std::optional<DataType> data_type(const PageFormat& p) {
+  if (p.format == SAMPLEFORMAT_UINT) {
+    if (p.bits == 8) return DataType::u8;
+    if (p.bits == 16) return DataType::u16;
+    if (p.bits == 32) return DataType::u32;
+  } else if (p.format == SAMPLEFORMAT_INT) {
+    if (p.bits == 8) return DataType::i8;
+    if (p.bits == 16) return DataType::i16;
+    if (p.bits == 32) return DataType::i32;
+  } else if (p.format == SAMPLEFORMAT_IEEEFP) {
+    if (p.bits == 32) return DataType::f32;
+    if (p.bits == 64) return DataType::f64;
+  }
+  return std::nullopt;
+}
+
 PageFormat page_format(const TiffFile& f, std::uint64_t page) {
   TIFF* t = f.get();
   PageFormat p;
@@ -91,12 +111,11 @@ PageFormat page_format(const TiffFile& f, std::uint64_t page) {
     throw file_error(ErrorCode::unsupported, f.path(), 0,
                      where + std::to_string(spp) + " samples per pixel (grayscale only)");
   }
-  const bool ok = (p.format == SAMPLEFORMAT_UINT && (p.bits == 8 || p.bits == 16)) ||
-                  (p.format == SAMPLEFORMAT_IEEEFP && p.bits == 32);
-  if (!ok) {
+  if (!data_type(p)) {
     throw file_error(ErrorCode::unsupported, f.path(), 0,
                      where + std::to_string(p.bits) + "-bit samples of format " +
-                         std::to_string(p.format) + " (8/16-bit unsigned or 32-bit float only)");
+                         std::to_string(p.format) +
+                         " (8/16/32-bit signed or unsigned integers, 32/64-bit float only)");
   }
   return p;
 }
@@ -212,7 +231,16 @@ std::unique_ptr<BrickSource> open_tiff_stack(const std::string& path, const Bric
   }
   VolumeDesc d;
   d.extent = {first.width, first.height, pages};
-  d.type = first.bits == 8 ? VoxelType::u8 : first.bits == 16 ? VoxelType::u16 : VoxelType::f32;
+  const DataType type = *data_type(first);
+  d.type = detail::voxel_type_for(type, false);
+  if (data_type_of(d.type) != type) {
+    // libtiff hands out samples in host byte order.
+    const Endian host = std::endian::native == std::endian::little ? Endian::little : Endian::big;
+    std::vector<std::byte> kept(voxels.size() / data_size(type) * voxel_size(d.type));
+    detail::convert_samples(voxels, type, host, false, 1.0, 0.0, kept);
+    voxels = std::move(kept);
+    d.data_type = type;
+  }
   PyramidSourceOptions o;
   o.ranges_from_data = true;
   // The voxels are read (or mapped) whole at open anyway, so the scan adds at most as much

@@ -1,10 +1,10 @@
-#include <bit>
 #include <cstring>
 #include <string>
 
 #include <blosc.h>
 
 #include "formats_inflate.hpp"
+#include "formats_samples.hpp"
 #include "resoct/codec.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/zarr_array.hpp"
@@ -55,18 +55,12 @@ void decode_lz4(std::span<const std::byte> in, std::span<std::byte> out,
   decompress_exact(Codec::lz4, in.subspan(4), out, location, 4);
 }
 
-void swap_bytes(std::span<std::byte> v, std::size_t width) {
-  for (std::size_t i = 0; i + width <= v.size(); i += width) {
-    for (std::size_t a = 0, b = width - 1; a < b; ++a, --b) std::swap(v[i + a], v[i + b]);
-  }
-}
-
 }  // namespace
 
 std::vector<std::byte> decode_zarr_chunk(const ZarrArrayMeta& meta,
                                          std::span<const std::byte> encoded,
                                          std::string_view location) {
-  const std::uint64_t bytes = meta.chunk_bytes();
+  const std::uint64_t bytes = meta.stored_chunk_bytes();
   if (bytes > kMaxZarrChunkBytes) {
     throw invalid_parameter("meta", "chunk of " + std::to_string(bytes) + " bytes is too large");
   }
@@ -90,12 +84,11 @@ std::vector<std::byte> decode_zarr_chunk(const ZarrArrayMeta& meta,
       detail::inflate_exact(encoded, out, detail::Deflate::gzip, location);
       break;
   }
-  const bool host_little = std::endian::native == std::endian::little;
-  const bool data_little = meta.endian == Endian::little;
-  if (voxel_size(meta.type) > 1 && host_little != data_little) {
-    swap_bytes(out, voxel_size(meta.type));
-  }
-  return out;
+  if (detail::samples_are_voxels(meta.data_type, meta.endian, false)) return out;
+  // Another byte order, a signed type kept with an offset, or a wide type kept as f32.
+  std::vector<std::byte> voxels(static_cast<std::size_t>(meta.chunk_bytes()));
+  detail::convert_samples(out, meta.data_type, meta.endian, false, 1.0, 0.0, voxels);
+  return voxels;
 }
 
 }  // namespace resoct

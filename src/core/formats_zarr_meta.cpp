@@ -1,6 +1,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -42,22 +44,27 @@ void parse_dtype(const Json& j, std::string_view location, ZarrArrayMeta& m) {
     throw j.is_array() ? unsupported(location, "dtype", "structured dtypes are not supported")
                        : corrupt(location, "dtype", "expected a string");
   }
+  // numpy's typestr: byte order ('<', '>', '|'), kind, bytes.
+  static const std::pair<std::string_view, DataType> kTypes[] = {
+      {"u1", DataType::u8},  {"i1", DataType::i8},  {"u2", DataType::u16}, {"i2", DataType::i16},
+      {"u4", DataType::u32}, {"i4", DataType::i32}, {"f4", DataType::f32}, {"f8", DataType::f64},
+  };
   const std::string d = j.get<std::string>();
-  if (d == "|u1" || d == "<u1" || d == ">u1") {
-    m.type = VoxelType::u8;
-  } else if (d == "<u2" || d == ">u2") {
-    m.type = VoxelType::u16;
-    m.endian = d[0] == '<' ? Endian::little : Endian::big;
-  } else if (d == "<f4" || d == ">f4") {
-    m.type = VoxelType::f32;
-    m.endian = d[0] == '<' ? Endian::little : Endian::big;
-  } else {
-    throw unsupported(location, "dtype",
-                      "'" + d + "' is not supported (|u1, <u2, >u2, <f4, >f4 are)");
+  const bool order = d.size() == 3 && (d[0] == '<' || d[0] == '>' || d[0] == '|');
+  for (const auto& [name, type] : kTypes) {
+    if (!order || std::string_view(d).substr(1) != name) continue;
+    if (d[0] == '|' && data_size(type) != 1) break;  // multi-byte values need a byte order
+    m.data_type = type;
+    m.type = data_mapping(type).stored;
+    m.endian = d[0] == '>' ? Endian::big : Endian::little;
+    return;
   }
+  throw unsupported(
+      location, "dtype",
+      "'" + d + "' is not supported (u1, i1, u2, i2, u4, i4, f4, f8 with '<' or '>')");
 }
 
-double parse_fill(const Json& j, std::string_view location, VoxelType t) {
+double parse_fill(const Json& j, std::string_view location, DataType t) {
   if (j.is_null()) return 0.0;
   double v = 0.0;
   if (j.is_string()) {
@@ -76,11 +83,24 @@ double parse_fill(const Json& j, std::string_view location, VoxelType t) {
   } else {
     throw corrupt(location, "fill_value", "expected a number, null or NaN/Infinity");
   }
-  if (t != VoxelType::f32) {
-    const double hi = t == VoxelType::u8 ? 255.0 : 65535.0;
-    if (!(v >= 0.0 && v <= hi && v == std::floor(v))) {
+  if (t != DataType::f32 && t != DataType::f64) {
+    // The integer types' value ranges (i32 and u32 values beyond 2^24 are rounded in f32, as
+    // their voxels are).
+    const double lo = t == DataType::i8    ? -128.0
+                      : t == DataType::i16 ? -32768.0
+                      : t == DataType::i32 ? -2147483648.0
+                                           : 0.0;
+    const double hi = t == DataType::u8    ? 255.0
+                      : t == DataType::i8  ? 127.0
+                      : t == DataType::u16 ? 65535.0
+                      : t == DataType::i16 ? 32767.0
+                      : t == DataType::i32 ? 2147483647.0
+                                           : 4294967295.0;
+    if (!(v >= lo && v <= hi && v == std::floor(v))) {
       throw corrupt(location, "fill_value",
-                    "must be an integer in 0.." + std::to_string(int(hi)) + ", got " + j.dump());
+                    "must be an integer in " + std::to_string(std::int64_t(lo)) + ".." +
+                        std::to_string(std::int64_t(hi)) + " for dtype " +
+                        std::string(to_string(t)) + ", got " + j.dump());
     }
   }
   return v;
@@ -175,7 +195,7 @@ ZarrArrayMeta parse_zarr_array_meta(std::string_view json, std::string_view loca
     throw unsupported(location, "filters", "filters are not supported");
   }
   m.compressor = parse_compressor(need("compressor"), location);
-  m.fill_value = parse_fill(need("fill_value"), location, m.type);
+  m.fill_value = parse_fill(need("fill_value"), location, m.data_type);
   if (j.contains("dimension_separator")) {
     const Json& s = j["dimension_separator"];
     if (s.is_string() && (s.get<std::string>() == "." || s.get<std::string>() == "/")) {
@@ -185,7 +205,7 @@ ZarrArrayMeta parse_zarr_array_meta(std::string_view json, std::string_view loca
     }
   }
   // Overflow-safe: every factor is >= 1, so dividing the limit bounds the product.
-  std::uint64_t bytes = voxel_size(m.type);
+  std::uint64_t bytes = data_size(m.data_type);  // never below voxel_size(m.type)
   for (std::uint64_t c : m.chunks) {
     if (c > kMaxZarrChunkBytes / bytes) {
       throw corrupt(location, "chunks",

@@ -26,6 +26,7 @@ struct ZarrImage {
   std::uint64_t timepoint = 0;
   std::unique_ptr<HostBrickCache> chunks;
   VoxelType type = VoxelType::u8;
+  DataType data_type = DataType::u8;
 };
 
 }  // namespace detail
@@ -64,7 +65,8 @@ std::shared_ptr<const HostBrick> chunk(const ZarrImage& img, std::size_t ds_inde
   } else {
     brick->voxels.resize(std::size_t(bytes));
     const std::size_t n = std::size_t(ds.meta.chunk_voxels());
-    const double f = ds.meta.fill_value;
+    // fill_value is in the file's units; voxels are kept as data_mapping() says.
+    const double f = ds.meta.fill_value + data_mapping(ds.meta.data_type).offset;
     switch (img.type) {
       case VoxelType::u8: std::memset(brick->voxels.data(), int(f), n); break;
       case VoxelType::u16: {
@@ -227,8 +229,9 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
   for (const OmeDataset& d : img->ms.datasets) img->datasets.push_back(load_dataset(*img, d.path));
   const ZarrDataset& d0 = img->datasets[0];
   img->type = d0.meta.type;
+  img->data_type = d0.meta.data_type;
   for (const ZarrDataset& ds : img->datasets) {
-    if (ds.meta.type != img->type) {
+    if (ds.meta.data_type != img->data_type) {
       throw dataset_error(*img, ds, "voxel type differs from the first dataset's");
     }
     for (int axis : {ds.t, ds.c}) {
@@ -311,6 +314,7 @@ std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> st
   VolumeDesc desc;
   desc.extent = d0.extent;
   desc.type = img->type;
+  if (data_type_of(img->type) != img->data_type) desc.data_type = img->data_type;
   desc.channels = d0.c >= 0 ? std::uint32_t(d0.meta.shape[std::size_t(d0.c)]) : 1u;
   for (int a = 0; a < 3; ++a) {
     if (d0.spatial[a] >= 0) desc.spacing[a] = img->ms.datasets[0].scale[std::size_t(d0.spatial[a])];
@@ -318,7 +322,9 @@ std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> st
   PyramidSourceOptions po = options.pyramid;
   if (img->ms.channels.size() == desc.channels) {
     for (const OmeChannel& c : img->ms.channels) {
-      if (c.window) desc.ranges.push_back(*c.window);
+      // omero windows are in the file's units, ranges in stored ones.
+      const double o = desc.value_offset();
+      if (c.window) desc.ranges.push_back({c.window->lo + o, c.window->hi + o});
     }
   }
   if (desc.ranges.size() != desc.channels) {

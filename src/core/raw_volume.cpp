@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "formats_samples.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct {
@@ -63,7 +64,7 @@ struct Mapping {
 std::string describe(const RawVolumeOptions& o) {
   return std::to_string(o.channels) + " channel(s) of " + std::to_string(o.extent.x) + "x" +
          std::to_string(o.extent.y) + "x" + std::to_string(o.extent.z) + " " +
-         std::string(to_string(o.type));
+         std::string(o.data_type ? to_string(*o.data_type) : to_string(o.type));
 }
 
 void swap_bytes(std::byte* data, std::size_t bytes, std::size_t width) {
@@ -81,13 +82,19 @@ DenseVolume open_raw_volume(const std::string& path, const RawVolumeOptions& opt
   desc.channels = options.channels;
   desc.type = options.type;
   desc.ranges = options.ranges;
+  const DataType file_type = options.data_type.value_or(data_type_of(options.type));
+  desc.type = data_mapping(file_type).stored;
+  if (data_type_of(desc.type) != file_type) {
+    desc.data_type = file_type;
+    for (ValueRange& r : desc.ranges) r = {r.lo + desc.value_offset(), r.hi + desc.value_offset()};
+  }
   // Names the offending parameter (extent.x, channels, ...) prefixed by the path, and rejects
   // byte counts beyond 64 bits before anything is opened.
   desc.validate(path);
   if (options.endian != Endian::little && options.endian != Endian::big) {
     throw Error(ErrorCode::invalid_argument, path + ": parameter 'endian': unknown byte order");
   }
-  const std::size_t width = voxel_size(options.type);
+  const std::size_t width = data_size(file_type);
   const std::uint64_t voxel_bytes = desc.voxel_count() * desc.channels * width;
   if (options.offset > std::numeric_limits<std::uint64_t>::max() - voxel_bytes) {
     throw Error(ErrorCode::overflow,
@@ -135,6 +142,13 @@ DenseVolume open_raw_volume(const std::string& path, const RawVolumeOptions& opt
   const std::byte* voxels =
       static_cast<const std::byte*>(mapping->base) + (options.offset - map_start);
 
+  if (desc.data_type) {
+    std::vector<std::byte> kept(std::size_t(desc.voxel_count() * desc.channels) *
+                                voxel_size(desc.type));
+    detail::convert_samples({voxels, std::size_t(voxel_bytes)}, file_type, options.endian, false,
+                            1.0, 0.0, kept);
+    return DenseVolume::from_bytes(std::move(desc), std::move(kept));
+  }
   const bool native = width == 1 || options.endian == host_endian();
   // Odd header sizes would leave multi-byte voxels misaligned; a copy realigns them.
   const bool aligned = options.offset % width == 0;

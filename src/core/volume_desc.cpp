@@ -12,6 +12,12 @@ ValueRange VolumeDesc::range(std::uint32_t c) const {
   return ranges.at(c);
 }
 
+ValueRange VolumeDesc::data_range(std::uint32_t c) const {
+  const ValueRange r = range(c);
+  const double o = value_offset();
+  return {r.lo - o, r.hi - o};
+}
+
 namespace {
 bool mul_overflows(std::uint64_t a, std::uint64_t b, std::uint64_t& out) {
   return __builtin_mul_overflow(a, b, &out);
@@ -48,6 +54,12 @@ void VolumeDesc::validate(const std::string& what) const {
   }
   if (type != VoxelType::u8 && type != VoxelType::u16 && type != VoxelType::f32) {
     throw Error(ErrorCode::invalid_argument, what + ": parameter 'type': unknown voxel type");
+  }
+  if (data_type && data_mapping(*data_type).stored != type) {
+    throw Error(ErrorCode::invalid_argument,
+                what + ": parameter 'data_type': " + std::string(to_string(*data_type)) +
+                    " is kept as " + std::string(to_string(data_mapping(*data_type).stored)) +
+                    ", not " + std::string(to_string(type)));
   }
   std::uint64_t n = 0;
   try {

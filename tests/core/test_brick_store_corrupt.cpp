@@ -230,6 +230,16 @@ TEST_P(CorruptStore, EachFailureClassHasItsOwnCode) {
     test::fix_header_crc(b);
     expect_open(b, ErrorCode::unsupported, "16");
   }
+  {  // a file value type the stored voxel type cannot hold (i16 is kept as u16), and no type
+    std::vector<std::uint8_t> b = bytes_;
+    const bool u16 = get_le(b, 20, 4) == std::uint32_t(VoxelType::u16);
+    put_le(b, lay::data_type, std::uint32_t(u16 ? DataType::i8 : DataType::i16), 4);
+    test::fix_header_crc(b);
+    expect_open(b, ErrorCode::corrupt, "180");
+    put_le(b, lay::data_type, 99, 4);
+    test::fix_header_crc(b);
+    expect_open(b, ErrorCode::corrupt, "180");
+  }
   {  // voxel count overflowing 64 bits
     std::vector<std::uint8_t> b = bytes_;
     for (int a = 0; a < 3; ++a) put_le(b, lay::extent + 8 * a, 1ull << 32, 8);

@@ -76,7 +76,8 @@ namespace layout {
 inline constexpr std::size_t version = 8, header_size = 12, flags = 16, extent = 24, channels = 72,
                              brick_size = 76, index_crc = 108, payload_offset = 120,
                              payload_size = 128, index_offset = 136, index_size = 144,
-                             metadata_offset = 152, metadata_size = 160, metadata_crc = 176;
+                             metadata_offset = 152, metadata_size = 160, metadata_crc = 176,
+                             data_type = 180;
 inline constexpr std::size_t entry_size = 40, entry_offset = 0, entry_size_field = 8,
                              entry_crc = 12, entry_flags = 32;
 }  // namespace layout

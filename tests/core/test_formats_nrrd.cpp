@@ -42,29 +42,30 @@ std::vector<std::uint8_t> gzip(const std::vector<std::uint8_t>& in) {
   return out;
 }
 
-/// Sample i of the test volume in the stored type, appended in the given byte order.
+/// Sample i of the test volume as the NRRD type stores it, appended in the given byte order.
 void append_sample(std::vector<std::uint8_t>& b, const std::string& type, double v, bool big) {
-  std::uint8_t tmp[4];
+  std::uint8_t tmp[8];
   std::size_t n = 0;
-  if (type == "uchar") {
-    tmp[0] = std::uint8_t(v), n = 1;
-  } else if (type == "short") {
-    const auto s = std::int16_t(v);
-    std::memcpy(tmp, &s, 2), n = 2;
-  } else if (type == "ushort") {
-    const auto s = std::uint16_t(v);
-    std::memcpy(tmp, &s, 2), n = 2;
-  } else {
-    const auto f = float(v);
-    std::memcpy(tmp, &f, 4), n = 4;
-  }
+  auto put = [&](auto x) { std::memcpy(tmp, &x, n = sizeof x); };
+  if (type == "uchar") put(std::uint8_t(v));
+  if (type == "signed char") put(std::int8_t(v));
+  if (type == "short") put(std::int16_t(v));
+  if (type == "ushort") put(std::uint16_t(v));
+  if (type == "int") put(std::int32_t(v));
+  if (type == "uint") put(std::uint32_t(v));
+  if (type == "float") put(float(v));
+  if (type == "double") put(v);
   for (std::size_t i = 0; i < n; ++i) b.push_back(big ? tmp[n - 1 - i] : tmp[i]);
 }
 
+/// Sample i in the file's units; exact in every mapping (|v| < 2^24 for the 32-bit integers).
 double sample_value(const std::string& type, std::size_t i) {
   if (type == "uchar") return double((i * 13) % 256);
+  if (type == "signed char") return double(std::int64_t(i * 13 % 256) - 128);
   if (type == "short") return double(std::int64_t(i * 211 % 4000) - 2000);
   if (type == "ushort") return double((i * 977) % 65536);
+  if (type == "int") return double(std::int64_t(i * 99991 % 16000000) - 8000000);
+  if (type == "uint") return double(i * 99991 % 16000000 + 3);
   return double(i) * 0.125 - 3.0;
 }
 
@@ -72,7 +73,8 @@ TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
   TempDir dir;
   const glm::u64vec3 e(6, 5, 4);
   const std::size_t n = 120;
-  for (const std::string type : {"uchar", "short", "ushort", "float"}) {
+  for (const std::string type :
+       {"uchar", "signed char", "short", "ushort", "int", "uint", "float", "double"}) {
     for (bool gz : {false, true}) {
       for (bool big : {false, true}) {
         for (bool detached : {false, true}) {
@@ -101,11 +103,17 @@ TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
           const VolumeDesc& d = src->volume();
           EXPECT_EQ(d.extent, e);
           EXPECT_EQ(d.spacing, glm::dvec3(0.5, 0.75, 2));
-          EXPECT_EQ(d.type, type == "uchar"    ? VoxelType::u8
-                            : type == "ushort" ? VoxelType::u16
-                                               : VoxelType::f32);
+          const bool one = type == "uchar" || type == "signed char";
+          const bool two = type == "short" || type == "ushort";
+          EXPECT_EQ(d.type, one ? VoxelType::u8 : two ? VoxelType::u16 : VoxelType::f32);
+          EXPECT_EQ(d.data_type.has_value(),
+                    type != "uchar" && type != "ushort" && type != "float");
+          // Values in the file's units: stored minus the mapping's offset (128 for signed char,
+          // 32768 for short).
           const auto v = level0_values(*src, 0);
-          for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(v[i], sample_value(type, i)) << i;
+          for (std::size_t i = 0; i < n; ++i) {
+            ASSERT_EQ(v[i] - d.value_offset(), sample_value(type, i)) << i;
+          }
         }
       }
     }
@@ -163,7 +171,7 @@ TEST(Nrrd, MalformedHeadersAndFiles) {
   EXPECT_RESOCT_ERROR(parse("NRRX0004\n"), ErrorCode::bad_magic, "h.nrrd");
   EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\n\n"),
                       ErrorCode::corrupt, "'encoding' is missing");
-  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: double\ndimension: 1\nsizes: 2\nencoding: raw\n\n"),
+  EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: longlong\ndimension: 1\nsizes: 2\nencoding: raw\n\n"),
                       ErrorCode::unsupported, "offset 9: NRRD field 'type'");
   EXPECT_RESOCT_ERROR(parse("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2\nencoding: raw\n\n"),
                       ErrorCode::corrupt, "NRRD field 'sizes'");

@@ -50,7 +50,7 @@ std::vector<std::byte> expected_voxels(const nlohmann::json& c, std::uint64_t t,
   const std::string axes = c["axes"];
   const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
   const std::string dtype = c["dtype"];
-  const std::size_t vs = dtype.substr(1) == "u1" ? 1 : dtype.substr(1) == "u2" ? 2 : 4;
+  const std::size_t vs = std::size_t(dtype[2] - '0');  // "<u2" -> 2, "|i1" -> 1, "<f8" -> 8
   const std::string raw = test::slurp(data_dir() + "/" + std::string(c["name"]) + ".raw");
   std::uint64_t total = 1;
   for (auto s : shape) total *= s;
@@ -95,7 +95,10 @@ TEST(OmeZarr, EveryCompressorDtypeChunkingAndAxisSubset) {
   const BrickLayout layout{glm::uvec3(4), 1};
   for (const auto& c : cases) {
     const std::string name = c["name"];
-    if (name.starts_with("pyramid") || name.starts_with("fill") || name == "omero") continue;
+    if (name.starts_with("pyramid") || name.starts_with("fill") || name.starts_with("typed") ||
+        name == "omero") {
+      continue;
+    }
     SCOPED_TRACE(name);
     const std::string axes = c["axes"];
     const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
@@ -171,6 +174,87 @@ TEST(OmeZarr, MissingChunksReadAsFillValue) {
       EXPECT_EQ(double(std::uint8_t(got.back())), fill);
     }
   }
+}
+
+/// The file values of one (t, c) of a case as doubles, x fastest (any dtype of the raw dump).
+std::vector<double> expected_values(const nlohmann::json& c, std::uint64_t channel) {
+  const std::string dtype = std::string(c["dtype"]).substr(1);
+  const std::size_t vs = std::size_t(dtype[1] - '0');
+  const auto bytes = expected_voxels(c, 0, channel);  // raw values, little-endian, vs each
+  std::vector<double> out;
+  for (std::size_t i = 0; i + vs <= bytes.size(); i += vs) {
+    auto get = [&](auto v) {
+      std::memcpy(&v, bytes.data() + i, sizeof v);
+      return double(v);
+    };
+    if (dtype == "i1") out.push_back(get(std::int8_t()));
+    if (dtype == "i2") out.push_back(get(std::int16_t()));
+    if (dtype == "i4") out.push_back(get(std::int32_t()));
+    if (dtype == "u4") out.push_back(get(std::uint32_t()));
+    if (dtype == "f8") out.push_back(get(double()));
+  }
+  return out;
+}
+
+// int8 and int16 are kept exactly as u8 / u16 plus 128 / 32768; int32, uint32 and float64 as
+// f32 (rounded to nearest, as a C++ float conversion does). Values, missing-chunk fill and omero
+// window come back in the file's units.
+TEST(OmeZarr, SignedAndWideDtypesKeepTheirValuesThroughTheMapping) {
+  ASSERT_FALSE(data_dir().empty());
+  std::size_t checked = 0;
+  const BrickLayout layout{glm::uvec3(4), 1};
+  for (const auto& c : manifest()["cases"]) {
+    const std::string name = c["name"];
+    if (!name.starts_with("typed")) continue;
+    SCOPED_TRACE(name);
+    const std::string dtype = std::string(c["dtype"]).substr(1);
+    const auto src = open_ome_zarr(data_dir() + "/" + name + ".zarr", layout);
+    const VolumeDesc& d = src->volume();
+    const DataType want_type = dtype == "i1"   ? DataType::i8
+                               : dtype == "i2" ? DataType::i16
+                               : dtype == "i4" ? DataType::i32
+                               : dtype == "u4" ? DataType::u32
+                                               : DataType::f64;
+    EXPECT_EQ(d.data_type, want_type);
+    EXPECT_EQ(d.type, dtype == "i1"   ? VoxelType::u8
+                      : dtype == "i2" ? VoxelType::u16
+                                      : VoxelType::f32);
+    for (std::uint32_t ch = 0; ch < d.channels; ++ch) {
+      const std::vector<double> want = expected_values(c, ch);
+      std::vector<std::byte> got(want.size() * voxel_size(d.type));
+      src->read_level_box(0, ch, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, got);
+      for (std::size_t i = 0; i < want.size(); ++i) {
+        double v = 0.0;
+        if (d.type == VoxelType::u8) v = double(std::uint8_t(got[i])) - 128.0;
+        if (d.type == VoxelType::u16) {
+          std::uint16_t u;
+          std::memcpy(&u, got.data() + 2 * i, 2);
+          v = double(u) - 32768.0;
+        }
+        if (d.type == VoxelType::f32) {
+          float f;
+          std::memcpy(&f, got.data() + 4 * i, 4);
+          v = double(f);
+        }
+        const double w = d.type == VoxelType::f32 ? double(float(want[i])) : want[i];
+        if (!(std::isnan(w) && std::isnan(v))) ASSERT_EQ(v, w) << "c " << ch << " voxel " << i;
+      }
+      if (name == "typed_fill_i2") {
+        EXPECT_EQ(want.back(), -1024.0);  // the last voxel lies in an unwritten chunk
+        EXPECT_EQ(d.data_range(0), (ValueRange{-1000.0, 2000.0}));  // the omero window
+      } else {
+        double lo = 1e300, hi = -1e300;
+        for (double w : want) {
+          if (std::isnan(w)) continue;
+          const double s = d.type == VoxelType::f32 ? double(float(w)) : w;
+          lo = std::min(lo, s), hi = std::max(hi, s);
+        }
+        EXPECT_EQ(d.data_range(ch), (ValueRange{lo, hi}));  // the data's own signed range
+      }
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 15u);
 }
 
 TEST(OmeZarr, OmeroWindowsAreChannelRanges) {

@@ -25,11 +25,14 @@ using test::TiffWriter;
 
 namespace {
 
+/// Values in the file's units, exact in every mapping (|v| < 2^24 for 32-bit integers).
 std::vector<double> values(const Page& p, std::uint32_t z) {
   std::vector<double> v(std::size_t(p.width) * p.height);
   for (std::size_t i = 0; i < v.size(); ++i) {
-    const double top = p.bits == 8 ? 256.0 : 65536.0;
-    v[i] = p.format == 3 ? double(i) * 0.5 - 2.25 + z : std::fmod(double(i * 37 + z * 101), top);
+    const double top = p.bits == 8 ? 256.0 : p.bits == 16 ? 65536.0 : 16777216.0;
+    v[i] = p.format == 3 ? double(i) * 0.5 - 2.25 + z
+                         : std::fmod(double(i * 37 + z * 101) * (p.bits == 32 ? 4099.0 : 1.0), top);
+    if (p.format == 2) v[i] -= top / 2;  // signed: both signs
   }
   return v;
 }
@@ -41,11 +44,13 @@ TEST(TiffStack, MultiPageFilesEveryTypeLayoutAndByteOrder) {
     VoxelType type;
   };
   for (const Kind k :
-       {Kind{8, 1, VoxelType::u8}, Kind{16, 1, VoxelType::u16}, Kind{32, 3, VoxelType::f32}}) {
+       {Kind{8, 1, VoxelType::u8}, Kind{8, 2, VoxelType::u8}, Kind{16, 1, VoxelType::u16},
+        Kind{16, 2, VoxelType::u16}, Kind{32, 1, VoxelType::f32}, Kind{32, 2, VoxelType::f32},
+        Kind{32, 3, VoxelType::f32}, Kind{64, 3, VoxelType::f32}}) {
     for (bool big : {false, true}) {
       for (int layout = 0; layout < 3; ++layout) {  // strips, deflate strips, tiles
-        SCOPED_TRACE(std::to_string(k.bits) + (big ? " big" : " little") + " layout " +
-                     std::to_string(layout));
+        SCOPED_TRACE(std::to_string(k.bits) + "-bit format " + std::to_string(k.format) +
+                     (big ? " big" : " little") + " layout " + std::to_string(layout));
         Page p;
         p.width = layout == 2 ? 37 : 7;
         p.height = layout == 2 ? 20 : 5;
@@ -63,8 +68,12 @@ TEST(TiffStack, MultiPageFilesEveryTypeLayoutAndByteOrder) {
         test::write_bytes(dir.file("s.tif"), w.bytes());
         const auto src = open_source(dir.file("s.tif"), BrickLayout{glm::uvec3(4), 1});
         EXPECT_EQ(src->volume().type, k.type);
+        EXPECT_EQ(src->volume().data_type.has_value(),
+                  k.format == 2 || k.bits == 64 || (k.format == 1 && k.bits == 32));
         EXPECT_EQ(src->volume().extent, glm::u64vec3(p.width, p.height, 3));
-        EXPECT_EQ(level0_values(*src, 0), want);
+        std::vector<double> got = level0_values(*src, 0);
+        for (double& v : got) v -= src->volume().value_offset();
+        EXPECT_EQ(got, want);
       }
     }
   }
@@ -109,15 +118,15 @@ TEST(TiffStack, UnsupportedAndDamagedFiles) {
   m.page(b);
   test::write_bytes(dir.file("mixed.tif"), m.bytes());
   EXPECT_RESOCT_ERROR(open_tiff_stack(dir.file("mixed.tif")), ErrorCode::corrupt, "page 1 is 8x5");
-  Page i16;
-  i16.bits = 16;
-  i16.format = 2;
-  i16.values = values(i16, 0);
+  Page u64;  // 64-bit integers: no mapping keeps them
+  u64.bits = 64;
+  u64.format = 1;
+  u64.values = std::vector<double>(std::size_t(u64.width) * u64.height, 0.0);
   TiffWriter s(false);
-  s.page(i16);
-  test::write_bytes(dir.file("signed.tif"), s.bytes());
-  EXPECT_RESOCT_ERROR(open_tiff_stack(dir.file("signed.tif")), ErrorCode::unsupported,
-                      "16-bit samples of format 2");
+  s.page(u64);
+  test::write_bytes(dir.file("wide.tif"), s.bytes());
+  EXPECT_RESOCT_ERROR(open_tiff_stack(dir.file("wide.tif")), ErrorCode::unsupported,
+                      "64-bit samples of format 1");
   test::write_bytes(dir.file("text.tif"), {'h', 'e', 'l', 'l', 'o'});
   EXPECT_RESOCT_ERROR(open_tiff_stack(dir.file("text.tif")), ErrorCode::bad_magic, "text.tif");
   // Damaged Deflate strips (IFD intact): the row is unreadable. Cut short: the IFD at the end

@@ -59,7 +59,9 @@ TEST(ZarrErrors, ArrayMetadata) {
   bad(zarray("\"shape\":[4, 0, 8];"), ErrorCode::corrupt, "key 'shape'");
   bad(zarray("\"chunks\":[2, 3];"), ErrorCode::corrupt, "key 'chunks': rank 2");
   bad(zarray("\"chunks\":[2000000, 2000000, 2];"), ErrorCode::corrupt, "decoded bytes");
-  bad(zarray("\"dtype\":\"<i4\";"), ErrorCode::unsupported, "key 'dtype'");
+  bad(zarray("\"dtype\":\"<i8\";"), ErrorCode::unsupported, "key 'dtype'");
+  bad(zarray("\"dtype\":\"|i2\";"), ErrorCode::unsupported, "key 'dtype'");  // no byte order
+  bad(zarray("\"dtype\":\"<i2\";\"fill_value\":40000;"), ErrorCode::corrupt, "-32768..32767");
   bad(zarray("\"dtype\":[[\"a\", \"<u2\"]];"), ErrorCode::unsupported, "structured");
   bad(zarray("\"order\":\"F\";"), ErrorCode::unsupported, "key 'order'");
   bad(zarray("\"filters\":[{\"id\": \"delta\"}];"), ErrorCode::unsupported, "key 'filters'");

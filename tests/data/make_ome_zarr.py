@@ -27,6 +27,7 @@ COMPRESSORS = {
     "none": lambda: None,
 }
 DTYPES = ["|u1", "<u2", ">u2", "<f4", ">f4"]
+TYPED_DTYPES = ["|i1", "<i2", ">i2", "<i4", ">u4", "<f8", ">f8"]
 # Axis subsets and their extents (t and c small, spatial extents not multiples of the chunks).
 AXES = {
     "zyx": {"z": 11, "y": 10, "x": 13},
@@ -48,9 +49,9 @@ def data(shape, dtype, seed):
     idx = np.indices(shape).sum(axis=0).astype(np.float64)
     base = 0.5 + 0.3 * np.sin(idx * 0.37) + 0.2 * rng.random_sample(shape)
     kind = np.dtype(dtype).kind
-    if kind == "u":
-        top = np.iinfo(np.dtype(dtype)).max
-        a = np.floor(base / 1.01 * top)
+    if kind in "ui":
+        info = np.iinfo(np.dtype(dtype))
+        a = np.floor(base / 1.01 * (float(info.max) - float(info.min))) + float(info.min)
         return a.astype(dtype)
     a = (base * 20.0 - 7.0).astype(np.float32)
     a.flat[:: 29] = np.nan
@@ -162,6 +163,23 @@ def main():
                     cases.append(write_case(outdir, name, names, shape, chunks, dtype, comp, sep,
                                             seed=i))
                     i += 1
+    # Signed and wide dtypes, kept by resoct through its value mapping (i1/i2 with an offset,
+    # u4/i4/f8 as f32): both byte orders, two compressors, a missing-chunk fill of the signed
+    # range and an omero window in the file's units.
+    for cname in ["blosc-lz4-shuffle", "zlib"]:
+        for dtype in TYPED_DTYPES:
+            names = list("czyx")
+            name = f"typed_{cname}_{dtype[0] == '>' and 'be' or 'le'}{dtype[1:]}"
+            cases.append(write_case(outdir, name, names, (2, 9, 10, 7), (1, 4, 3, 5), dtype,
+                                    COMPRESSORS[cname], "/", seed=i))
+            i += 1
+    ct_window = {"channels": [{"label": "CT", "color": "FFFFFF", "active": True,
+                               "window": {"start": -1000, "end": 2000, "min": -32768,
+                                          "max": 32767}}]}
+    cases.append(write_case(outdir, "typed_fill_i2", list("zyx"), (12, 14, 16), (4, 4, 4), "<i2",
+                            COMPRESSORS["zstd"], "/", fill=-1024,
+                            region=(slice(0, 5), slice(0, 6), slice(2, 9)), omero=ct_window,
+                            seed=404))
     # Multiscales: three stored levels (2x per spatial axis each), coarser ones built by resoct.
     for dtype in ["<u2", ">f4"]:
         names = list("czyx")

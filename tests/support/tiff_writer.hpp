@@ -15,7 +15,7 @@ namespace resoct::test {
 /// One page: its layout and width * height sample values (x fastest).
 struct Page {
   std::uint32_t width = 7, height = 5;
-  std::uint16_t bits = 8, format = 1, spp = 1;  // format 1 = uint, 3 = IEEE float
+  std::uint16_t bits = 8, format = 1, spp = 1;  // format 1 = uint, 2 = int, 3 = IEEE float
   bool deflate = false;
   std::uint32_t tile = 0;      // 0: strips of 2 rows; else square tiles (multiple of 16)
   std::vector<double> values;  // width * height, x fastest
@@ -48,9 +48,14 @@ class TiffWriter {
     auto sample = [&](std::vector<std::uint8_t>& out, std::uint32_t x, std::uint32_t y) {
       const double v = x < p.width && y < p.height ? p.values[y * p.width + x] : 0.0;
       for (std::uint16_t s = 0; s < p.spp; ++s) {
-        if (p.bits == 8) out.push_back(std::uint8_t(v));
-        if (p.bits == 16) put(out, std::uint16_t(v));
-        if (p.bits == 32) put(out, float(v));
+        const bool sint = p.format == 2, real = p.format == 3;
+        if (p.bits == 8) out.push_back(sint ? std::uint8_t(std::int8_t(v)) : std::uint8_t(v));
+        if (p.bits == 16 && !sint) put(out, std::uint16_t(v));
+        if (p.bits == 16 && sint) put(out, std::int16_t(v));
+        if (p.bits == 32 && real) put(out, float(v));
+        if (p.bits == 32 && !real && !sint) put(out, std::uint32_t(v));
+        if (p.bits == 32 && sint) put(out, std::int32_t(v));
+        if (p.bits == 64 && real) put(out, v);
       }
     };
     const std::uint32_t rows = 2;

@@ -231,6 +231,70 @@ TEST(Tools, ConvertRawF32TakesItsRangeFromTheData) {
   EXPECT_EQ(store.volume().range(0), (ValueRange{double(lo), double(hi)}));
 }
 
+// int16 CT as users have it: the store keeps u16 + 32768 (two bytes, exact), remembers that the
+// file was int16, and resoct-info reports the type and the window in the file's units. A
+// float64 file is kept as f32 and the conversion says that it rounds.
+TEST(Tools, ConvertRawSignedAndWideTypes) {
+  TempDir dir;
+  const glm::u64vec3 e{12, 10, 8};
+  std::vector<std::uint8_t> i16_file;
+  std::vector<std::uint16_t> stored;  // what the cache must hold: value + 32768
+  for (std::size_t i = 0; i < e.x * e.y * e.z; ++i) {
+    const auto v = std::int16_t(std::int64_t(i * 37 % 3000) - 1024);  // air near -1024
+    const auto bits = std::uint16_t(v);
+    i16_file.push_back(std::uint8_t(bits & 0xFF));
+    i16_file.push_back(std::uint8_t(bits >> 8));
+    stored.push_back(std::uint16_t(std::int32_t(v) + 32768));
+  }
+  const std::string raw = dir.file("ct.raw"), out = dir.file("ct.rbs");
+  resoct::test::write_bytes(raw, i16_file);
+  const ToolRun r = run(dir, RESOCT_CONVERT,
+                        shell_quote(raw) + " " + shell_quote(out) +
+                            " --dims 12x10x8 --type i16 --range -1000,2000 --brick 8");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const BrickStoreSource store(out);
+  EXPECT_EQ(store.volume().type, VoxelType::u16);
+  EXPECT_EQ(store.volume().data_type, DataType::i16);
+  EXPECT_EQ(store.volume().range(0), (ValueRange{31768.0, 34768.0}));
+  EXPECT_EQ(store.volume().data_range(0), (ValueRange{-1000.0, 2000.0}));
+  VolumeDesc d;
+  d.extent = e;
+  d.type = VoxelType::u16;
+  d.data_type = DataType::i16;
+  d.ranges = {ValueRange{31768.0, 34768.0}};
+  expect_same_bricks(store, InMemorySource(DenseVolume::from_values(d, stored), layout_of(8)));
+  const ToolRun info = run(dir, RESOCT_INFO, shell_quote(out) + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json j = nlohmann::json::parse(info.out);
+  EXPECT_EQ(j["volume"]["type"], "i16");
+  EXPECT_EQ(j["volume"]["stored_type"], "u16");
+  EXPECT_EQ(j["volume"]["value_offset"], 32768.0);
+  EXPECT_EQ(j["volume"]["exact"], true);
+  EXPECT_EQ(j["volume"]["ranges"], nlohmann::json::parse("[[-1000.0, 2000.0]]"));
+  const ToolRun text = run(dir, RESOCT_INFO, shell_quote(out));
+  EXPECT_NE(text.out.find("i16 (kept as u16, value + 32768: exact)"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("[-1000, 2000]"), std::string::npos) << text.out;
+
+  std::vector<std::uint8_t> f64_file;
+  for (std::size_t i = 0; i < e.x * e.y * e.z; ++i) {
+    const double v = double(i) * 0.1 - 3.0;
+    const auto bits = std::bit_cast<std::uint64_t>(v);
+    for (int k = 0; k < 8; ++k) f64_file.push_back(std::uint8_t(bits >> (8 * k)));
+  }
+  const std::string raw64 = dir.file("f.raw"), out64 = dir.file("f.rbs");
+  resoct::test::write_bytes(raw64, f64_file);
+  const ToolRun r64 =
+      run(dir, RESOCT_CONVERT,
+          shell_quote(raw64) + " " + shell_quote(out64) + " --dims 12x10x8 --type f64");
+  ASSERT_EQ(r64.exit_code, 0) << r64.err;
+  EXPECT_NE(r64.err.find("f64 (kept as f32: rounded)"), std::string::npos) << r64.err;
+  const BrickStoreSource store64(out64);
+  EXPECT_EQ(store64.volume().data_type, DataType::f64);
+  const double last = double(e.x * e.y * e.z - 1) * 0.1 - 3.0;  // the largest value written
+  EXPECT_EQ(store64.volume().data_range(0), (ValueRange{-3.0, double(float(last))}));
+}
+
 // A bad invocation: non-zero exit, exactly one line on stderr containing `needle`, and nothing
 // left in the directory (no output, no temporary file).
 void expect_clean_failure(const std::string& args, const std::string& needle,

@@ -5,12 +5,11 @@
 /// Voxel mapping (the volume is served in voxel index order i, j, k = x, y, z; no reorientation):
 /// - scl_slope and scl_inter that are NaN or infinite read as 0 (as in niftilib), and a
 ///   scl_slope of 0 means no scaling, scl_inter ignored (the NIfTI-1 rule);
-/// - u8 and u16 without scaling (scl_slope 0, or 1 with scl_inter 0) stay u8 / u16;
-/// - i16 becomes f32 holding the same integer values (every i16 value is exact in f32, and
-///   resoct has no signed type);
+/// - without scaling (scl_slope 0, or 1 with scl_inter 0) values keep their type through
+///   data_mapping() (voxel_type.hpp): u8, u16, f32 as they are, int8 / int16 exactly as u8 / u16
+///   plus an offset (VolumeDesc::data_type says so), int32, uint32 and float64 as f32 (rounded);
 /// - any scaling (scl_slope not 0 and either not 1 or scl_inter not 0) gives
-///   f32 = slope * v + inter;
-/// - f32 stays f32.
+///   f32 = slope * v + inter.
 /// Spacing: the column lengths of the sform matrix when sform_code > 0, else |pixdim[1..3]|
 /// (qform and the fallback method share pixdim); a zero or non-finite spacing becomes 1.
 /// A 4-D file's volumes (dim[4] up to 256) become channels; dims 5..7 must be 1.
@@ -28,17 +27,16 @@
 
 #include "resoct/brick_source.hpp"
 #include "resoct/raw_volume.hpp"
+#include "resoct/voxel_type.hpp"
 
 namespace resoct {
-
-/// NIfTI-1 datatype codes resoct reads.
-enum class NiftiDatatype : std::int16_t { u8 = 2, i16 = 4, f32 = 16, u16 = 512 };
 
 /// The fields of a NIfTI-1 header that resoct uses.
 struct NiftiHeader {
   Endian endian = Endian::little;     ///< from sizeof_hdr (348 in the file's byte order)
   std::array<std::int64_t, 8> dim{};  ///< dim[0] = rank 1..7, dim[1..rank] >= 1
-  NiftiDatatype datatype = NiftiDatatype::u8;
+  /// From the datatype code: 2 u8, 256 i8, 4 i16, 512 u16, 8 i32, 768 u32, 16 f32, 64 f64.
+  DataType datatype = DataType::u8;
   std::array<float, 8> pixdim{};
   std::uint64_t vox_offset = 352;  ///< byte offset of the first voxel (>= 348)
   float scl_slope = 0.0f;          ///< 0 when the file's value is NaN or infinite
@@ -65,8 +63,9 @@ struct NiftiHeader {
 /// Error(bad_magic) when sizeof_hdr is not 348 in either byte order or the magic is not "n+1"
 /// (the two-file "ni1" form is reported as unsupported), Error(corrupt) naming the field and
 /// its offset for a rank outside 1..7, a non-positive dimension or a vox_offset below 348,
-/// Error(unsupported) for a datatype other than u8/i16/u16/f32, bitpix disagreeing with it, or
-/// dims 5..7 above 1, Error(overflow) when the data size overflows. Thread-safety: pure.
+/// Error(unsupported) for a datatype other than those of NiftiHeader::datatype, bitpix disagreeing
+/// with it, or dims 5..7 above 1, Error(overflow) when the data size overflows. Thread-safety:
+/// pure.
 NiftiHeader parse_nifti_header(std::span<const std::byte> bytes, std::string_view location);
 
 /// Opens a .nii or .nii.gz file (gzip recognised by its magic bytes) as a brick source whose

@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// NRRD volumes (.nrrd with attached data, .nhdr with a detached data file) as brick sources.
-/// Encodings raw and gzip; types uchar/uint8, ushort/uint16, short/int16 (served as f32 holding
-/// the same values, as for NIfTI), float; 1..4 dimensions: up to three spatial axes (x fastest),
+/// Encodings raw and gzip; types (u)char/(u)int8, (u)short/(u)int16, (u)int/(u)int32, float,
+/// double, kept through data_mapping() (voxel_type.hpp: int8 / int16 exactly with an offset,
+/// 32-bit integers and double as f32); 1..4 dimensions: up to three spatial axes (x fastest),
 /// plus a channel axis that is either the first (interleaved, kind vector/list/RGB-color/...) or
 /// the last (one volume after another). Spacing from `spacings`, else the lengths of the
 /// `space directions` vectors, else 1. Each channel's value range is its data's finite min/max.
@@ -17,15 +18,13 @@
 
 #include "resoct/brick_source.hpp"
 #include "resoct/raw_volume.hpp"
+#include "resoct/voxel_type.hpp"
 
 namespace resoct {
 
-/// Stored NRRD sample types resoct reads.
-enum class NrrdType : std::uint8_t { u8, i16, u16, f32 };
-
 /// The fields of an NRRD header that resoct uses.
 struct NrrdHeader {
-  NrrdType type = NrrdType::u8;
+  DataType type = DataType::u8;
   std::vector<std::uint64_t> sizes;  ///< per axis, fastest first
   bool gzip = false;                 ///< encoding gzip (else raw)
   Endian endian = Endian::little;

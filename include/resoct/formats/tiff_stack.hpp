@@ -2,9 +2,10 @@
 /// \file
 /// TIFF stacks as brick sources, read with libtiff: a multi-page file (each page a z slice) or
 /// a directory of TIFF files (.tif / .tiff, sorted by name; every page of every file is a z
-/// slice in that order). Pages are single-sample grayscale, 8- or 16-bit unsigned or 32-bit
-/// IEEE float, stored in strips or tiles with any compression libtiff decodes; all pages share
-/// width, height and sample format. Voxel values are used as stored (MinIsWhite is not
+/// slice in that order). Pages are single-sample grayscale, 8-, 16- or 32-bit signed or unsigned
+/// integers or 32- or 64-bit IEEE float (kept through data_mapping(), voxel_type.hpp), stored in
+/// strips or tiles with any compression libtiff decodes; all pages share width, height and
+/// sample format. Voxel values are used as stored (MinIsWhite is not
 /// inverted), spacing is 1, and each channel's value range is its data's finite min/max.
 
 #include <memory>

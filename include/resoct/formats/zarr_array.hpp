@@ -2,7 +2,9 @@
 /// \file
 /// Zarr v2 arrays: the `.zarray` metadata and the decoding of one stored chunk. Parsers are free
 /// functions over bytes so that fuzz targets and the HTTP reader call exactly what the zarr
-/// source calls. Supported: dtypes |u1, <u2, >u2, <f4, >f4; C order; no filters; compressors
+/// source calls. Supported: dtypes u1, i1, u2, i2, u4, i4, f4, f8 of either byte order (kept
+/// through data_mapping(), voxel_type.hpp: i1 / i2 exactly with an offset, u4, i4 and f8 as f32,
+/// rounded); C order; no filters; compressors
 /// blosc (any inner codec libblosc was built with, byte or bit shuffle), lz4 (numcodecs framing:
 /// a 4-byte little-endian size, then one LZ4 block), zstd, zlib, gzip, none.
 
@@ -33,18 +35,21 @@ inline constexpr std::uint64_t kMaxZarrChunkBytes = std::uint64_t(1) << 30;
 struct ZarrArrayMeta {
   std::vector<std::uint64_t> shape;   ///< voxels per dimension, each >= 1
   std::vector<std::uint64_t> chunks;  ///< chunk shape, same rank, each >= 1
-  VoxelType type = VoxelType::u8;     ///< decoded voxel type
-  Endian endian = Endian::little;     ///< byte order of stored u2 / f4 voxels
+  DataType data_type = DataType::u8;  ///< type of the stored values (the dtype)
+  VoxelType type = VoxelType::u8;     ///< decoded voxel type: data_mapping(data_type).stored
+  Endian endian = Endian::little;     ///< byte order of stored multi-byte values
   ZarrCompressor compressor = ZarrCompressor::none;
-  double fill_value = 0.0;         ///< value of voxels in missing chunks (null: 0)
+  double fill_value = 0.0;         ///< value of voxels in missing chunks (null: 0), file units
   char dimension_separator = '.';  ///< '.' or '/' between chunk indices in chunk keys
 
   /// Chunks per dimension: ceil(shape / chunks).
   std::vector<std::uint64_t> chunk_grid() const;
   /// Voxels in one (full) chunk.
   std::uint64_t chunk_voxels() const;
-  /// Decoded bytes of one chunk: chunk_voxels() * voxel_size(type).
+  /// Decoded bytes of one chunk as resoct voxels: chunk_voxels() * voxel_size(type).
   std::uint64_t chunk_bytes() const { return chunk_voxels() * voxel_size(type); }
+  /// Bytes of one chunk as stored values before compression: chunk_voxels() * data_size(data_type).
+  std::uint64_t stored_chunk_bytes() const { return chunk_voxels() * data_size(data_type); }
   /// The store key of a chunk relative to the array: "2.0.13" or "2/0/13".
   std::string chunk_key(std::span<const std::uint64_t> chunk_index) const;
 };
@@ -56,7 +61,8 @@ struct ZarrArrayMeta {
 /// compressor or an unsupported dtype. Thread-safety: a pure function.
 ZarrArrayMeta parse_zarr_array_meta(std::string_view json, std::string_view location);
 
-/// Decodes one stored chunk into its chunk_bytes() native-endian voxels (zarr stores border
+/// Decodes one stored chunk into its chunk_bytes() native-endian voxels, values mapped by
+/// data_mapping(data_type) (zarr stores border
 /// chunks at full size too). Throws Error(decompress_failed) naming `location` when the codec
 /// rejects the bytes, Error(size_mismatch) when they decode to another size than the chunk,
 /// Error(corrupt) for a damaged blosc or lz4 header. Thread-safety: a pure function.

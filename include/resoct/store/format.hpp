@@ -49,7 +49,9 @@ inline constexpr std::uint64_t metadata_offset = 152;
 inline constexpr std::uint64_t metadata_size = 160;
 inline constexpr std::uint64_t metadata_raw_size = 168;
 inline constexpr std::uint64_t metadata_crc = 176;
-inline constexpr std::uint64_t reserved = 180;
+/// 0: the values are voxel_type's own; else the DataType code (3..7) of the file the store was
+/// converted from, whose data_mapping() gives voxel_type (VolumeDesc::data_type).
+inline constexpr std::uint64_t data_type = 180;
 inline constexpr std::uint64_t ranges = 184;  // channels x (f64 lo, f64 hi), then the CRC
 /// Fixed part before the ranges plus the trailing CRC.
 inline constexpr std::uint64_t fixed_size = 188;
