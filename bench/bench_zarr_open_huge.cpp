@@ -32,6 +32,17 @@ class MemoryStore final : public ByteStore {
     const auto* p = reinterpret_cast<const std::byte*>(s.data()) + offset;
     return std::vector<std::byte>(p, p + size);
   }
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override {
+    if (!objects_.contains(std::string(key))) return std::nullopt;
+    return get_range(key, offset, size);
+  }
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override {
+    const auto it = objects_.find(std::string(key));
+    if (it == objects_.end()) return std::nullopt;
+    return ObjectTail{get_range(key, it->second.size() - size, size), it->second.size()};
+  }
   std::string location(std::string_view key) const override {
     return "mem://bench/" + std::string(key);
   }

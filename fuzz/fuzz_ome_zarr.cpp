@@ -65,6 +65,22 @@ class MemoryStore final : public ByteStore {
     return {b.begin() + std::ptrdiff_t(offset), b.begin() + std::ptrdiff_t(offset + size)};
   }
 
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override {
+    if (!objects_.contains(std::string(key))) return std::nullopt;
+    return get_range(key, offset, size);
+  }
+
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override {
+    const auto it = objects_.find(std::string(key));
+    if (it == objects_.end()) return std::nullopt;
+    const std::uint64_t n = it->second.size();
+    if (size > n)
+      throw file_error(ErrorCode::truncated, location(key), 0, "suffix beyond the object");
+    return ObjectTail{get_range(key, n - size, size), n};
+  }
+
   std::string location(std::string_view key) const override {
     return "mem://fuzz/" + std::string(key);
   }

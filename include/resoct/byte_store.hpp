@@ -15,6 +15,12 @@
 
 namespace resoct {
 
+/// The end of an object and the object's size (ByteStore::get_suffix).
+struct ObjectTail {
+  std::vector<std::byte> bytes;
+  std::uint64_t object_size = 0;
+};
+
 /// Keys are relative, '/'-separated paths without "." or ".." components.
 /// Thread-safety: implementations must allow every member to be called from any number of
 /// threads at once (brick loader threads read concurrently).
@@ -35,6 +41,18 @@ class ByteStore {
   /// Error for every failure get() reports.
   virtual std::vector<std::byte> get_range(std::string_view key, std::uint64_t offset,
                                            std::uint64_t size) const = 0;
+
+  /// get_range(), except that an absent object is nullopt instead of an error (a missing zarr
+  /// shard is all fill value: absence is an answer).
+  virtual std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                                     std::uint64_t offset,
+                                                                     std::uint64_t size) const = 0;
+
+  /// The last `size` bytes of the object at `key` and the object's size, or nullopt when the
+  /// store has no such object; read without reading the rest of the object (a zarr shard's index
+  /// at its end). Throws Error(truncated) naming location(key) when the object is shorter than
+  /// `size`, and Error for every failure get() reports.
+  virtual std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const = 0;
 
   /// Where `key` lives, for messages: "/data/x.zarr/0/.zarray" or "http://host/x.zarr/0/.zarray".
   virtual std::string location(std::string_view key) const = 0;

@@ -91,6 +91,16 @@ class HttpStore final : public ByteStore {
   /// is shorter (also for 416), Error(io) for 404 and failures as get().
   std::vector<std::byte> get_range(std::string_view key, std::uint64_t offset,
                                    std::uint64_t size) const override;
+  /// get_range, but nullopt for HTTP 404/410.
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override;
+  /// GET with a suffix range "Range: bytes=-size"; the object size comes from the 206 answer's
+  /// Content-Range. A server that answers it with 200 (the transfer is aborted after the
+  /// headers), 400, 416 or 501 does not do suffix ranges: the store remembers that and reads
+  /// the size with HEAD and the bytes with a first-last range from then on. nullopt for
+  /// 404/410; Error(truncated) naming the URL when the object is shorter than `size`.
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override;
   /// Writes the range into `out` (size = out.size()) without an intermediate vector.
   void read_range(std::string_view key, std::uint64_t offset, std::span<std::byte> out) const;
   /// Object size from a HEAD request's Content-Length; nullopt for 404/410. Throws as get().
@@ -103,6 +113,10 @@ class HttpStore final : public ByteStore {
   HttpStats stats() const;
 
  private:
+  /// A first-last range request into `out`; false when the object is absent.
+  bool read_range_if_present(std::string_view key, std::uint64_t offset,
+                             std::span<std::byte> out) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

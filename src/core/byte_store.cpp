@@ -74,6 +74,29 @@ class DirectoryStore final : public ByteStore {
     return bytes;
   }
 
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override {
+    std::error_code ec;
+    if (!std::filesystem::exists(resolve(key), ec)) return std::nullopt;
+    return get_range(key, offset, size);
+  }
+
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override {
+    const std::string path = resolve(key);
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return std::nullopt;
+    ReadFile file(path);
+    if (size > file.size()) {
+      throw file_error(ErrorCode::truncated, path, 0,
+                       "object of " + std::to_string(file.size()) + " bytes is shorter than the " +
+                           std::to_string(size) + " bytes wanted from its end");
+    }
+    ObjectTail tail{std::vector<std::byte>(size), file.size()};
+    file.read_at(file.size() - size, tail.bytes);
+    return tail;
+  }
+
   std::string location(std::string_view key) const override {
     return root_ + "/" + std::string(key);
   }

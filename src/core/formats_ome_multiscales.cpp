@@ -119,13 +119,14 @@ void transforms(const Json& j, std::size_t n, std::string_view location, const s
   if (need_scale && !have_scale) throw corrupt(location, key, "no scale transformation");
 }
 
-void parse_omero(const Json& j, std::string_view location, OmeMultiscales& m) {
+void parse_omero(const Json& j, std::string_view location, const std::string& prefix,
+                 OmeMultiscales& m) {
   if (!j.is_object() || !j.contains("channels")) return;
   const Json& chans = j["channels"];
-  if (!chans.is_array()) throw corrupt(location, "omero.channels", "expected an array");
+  if (!chans.is_array()) throw corrupt(location, prefix + "omero.channels", "expected an array");
   for (std::size_t i = 0; i < chans.size(); ++i) {
     const Json& c = chans[i];
-    const std::string key = "omero.channels[" + std::to_string(i) + "]";
+    const std::string key = prefix + "omero.channels[" + std::to_string(i) + "]";
     if (!c.is_object()) throw corrupt(location, key, "expected an object");
     OmeChannel ch;
     if (c.contains("label") && c["label"].is_string()) ch.label = c["label"].get<std::string>();
@@ -152,32 +153,44 @@ int OmeMultiscales::axis_index(char axis) const noexcept {
   return -1;
 }
 
-OmeMultiscales parse_ome_multiscales(std::string_view json, std::string_view location) {
-  Json j;
+namespace {
+
+Json parse_json(std::string_view json, std::string_view location) {
   try {
-    j = Json::parse(json.begin(), json.end());
+    return Json::parse(json.begin(), json.end());
   } catch (const Json::exception& e) {
     throw Error(ErrorCode::corrupt, std::string(location) + ": not valid JSON: " + e.what());
   }
+}
+
+/// The image metadata of `attrs` (the `.zattrs` object of 0.4, `attributes.ome` of 0.5); keys
+/// in messages start with `prefix`. `version` is 0.5's `attributes.ome.version`, or empty for
+/// 0.4, whose version sits in each multiscales entry.
+OmeMultiscales parse_image_attributes(const Json& j, std::string_view location,
+                                      const std::string& prefix, const std::string& version) {
   if (!j.is_object() || !j.contains("multiscales")) {
-    throw Error(ErrorCode::bad_magic,
-                std::string(location) + ": no 'multiscales' key (not an OME-Zarr image group)");
+    throw Error(ErrorCode::bad_magic, std::string(location) + ": no '" + prefix +
+                                          "multiscales' key (not an OME-Zarr image group)");
   }
   const Json& all = j["multiscales"];
   if (!all.is_array() || all.empty() || !all[0].is_object()) {
-    throw corrupt(location, "multiscales", "expected a non-empty array of objects");
+    throw corrupt(location, prefix + "multiscales", "expected a non-empty array of objects");
   }
   const Json& ms = all[0];
-  const std::string base = "multiscales[0]";
+  const std::string base = prefix + "multiscales[0]";
   OmeMultiscales m;
-  if (!ms.contains("version") || !ms["version"].is_string()) {
-    throw corrupt(location, base + ".version", "missing or not a string");
-  }
-  m.version = ms["version"].get<std::string>();
-  if (m.version != "0.4") {
-    throw Error(ErrorCode::unsupported_version, std::string(location) + ": key '" + base +
-                                                    ".version': '" + m.version +
-                                                    "' is not supported (NGFF 0.4)");
+  if (version.empty()) {
+    if (!ms.contains("version") || !ms["version"].is_string()) {
+      throw corrupt(location, base + ".version", "missing or not a string");
+    }
+    m.version = ms["version"].get<std::string>();
+    if (m.version != "0.4") {
+      throw Error(ErrorCode::unsupported_version, std::string(location) + ": key '" + base +
+                                                      ".version': '" + m.version +
+                                                      "' is not supported (NGFF 0.4)");
+    }
+  } else {
+    m.version = version;
   }
   if (ms.contains("name") && ms["name"].is_string()) m.name = ms["name"].get<std::string>();
   if (!ms.contains("axes")) throw corrupt(location, base + ".axes", "missing");
@@ -215,8 +228,46 @@ OmeMultiscales parse_ome_multiscales(std::string_view json, std::string_view loc
                  ds.scale, ds.translation, false);
     }
   }
-  if (j.contains("omero")) parse_omero(j["omero"], location, m);
+  if (j.contains("omero")) parse_omero(j["omero"], location, prefix, m);
   return m;
+}
+
+}  // namespace
+
+OmeMultiscales parse_ome_multiscales(std::string_view json, std::string_view location) {
+  return parse_image_attributes(parse_json(json, location), location, "", "");
+}
+
+OmeMultiscales parse_ome_zarr_group(std::string_view json, std::string_view location) {
+  const Json j = parse_json(json, location);
+  if (!j.is_object()) throw corrupt(location, "(root)", "expected a JSON object");
+  if (!j.contains("zarr_format") || j["zarr_format"] != 3) {
+    throw Error(ErrorCode::unsupported_version,
+                std::string(location) + ": key 'zarr_format': " +
+                    (j.contains("zarr_format") ? j["zarr_format"].dump() : "missing") +
+                    " (a zarr v3 group has 3)");
+  }
+  if (!j.contains("node_type") || j["node_type"] != "group") {
+    throw Error(ErrorCode::bad_magic,
+                std::string(location) + ": key 'node_type': not \"group\" (not an image group)");
+  }
+  if (!j.contains("attributes") || !j["attributes"].is_object() ||
+      !j["attributes"].contains("ome")) {
+    throw Error(ErrorCode::bad_magic,
+                std::string(location) + ": no 'attributes.ome' key (not an OME-Zarr image group)");
+  }
+  const Json& ome = j["attributes"]["ome"];
+  if (!ome.is_object()) throw corrupt(location, "attributes.ome", "expected an object");
+  if (!ome.contains("version") || !ome["version"].is_string()) {
+    throw corrupt(location, "attributes.ome.version", "missing or not a string");
+  }
+  const std::string version = ome["version"].get<std::string>();
+  if (version != "0.5") {
+    throw Error(ErrorCode::unsupported_version, std::string(location) +
+                                                    ": key 'attributes.ome.version': '" + version +
+                                                    "' is not supported (NGFF 0.5)");
+  }
+  return parse_image_attributes(ome, location, "attributes.ome.", version);
 }
 
 }  // namespace resoct

@@ -5,18 +5,18 @@
 
 #include "formats_inflate.hpp"
 #include "formats_samples.hpp"
+#include "formats_zarr_codec_steps.hpp"
 #include "resoct/codec.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/zarr_array.hpp"
 
 namespace resoct {
 
-namespace {
+namespace detail {
 
-void decode_blosc(std::span<const std::byte> in, std::span<std::byte> out,
-                  std::string_view location) {
+std::uint64_t blosc_frame_bytes(std::span<const std::byte> in, std::string_view location) {
   // blosc_cbuffer_validate checks the header against the buffer length before anything is
-  // read past it; blosc_decompress_ctx then never writes more than destsize.
+  // read past it.
   std::size_t nbytes = 0;
   if (in.size() < BLOSC_MIN_HEADER_LENGTH ||
       blosc_cbuffer_validate(in.data(), in.size(), &nbytes) != 0) {
@@ -24,6 +24,13 @@ void decode_blosc(std::span<const std::byte> in, std::span<std::byte> out,
                                         ": offset 0: not a valid blosc frame (" +
                                         std::to_string(in.size()) + " bytes)");
   }
+  return nbytes;
+}
+
+void decode_blosc(std::span<const std::byte> in, std::span<std::byte> out,
+                  std::string_view location) {
+  // blosc_decompress_ctx never writes more than destsize.
+  const std::uint64_t nbytes = blosc_frame_bytes(in, location);
   if (nbytes != out.size()) {
     throw Error(ErrorCode::size_mismatch, std::string(location) + ": blosc frame holds " +
                                               std::to_string(nbytes) + " bytes, the chunk " +
@@ -37,6 +44,16 @@ void decode_blosc(std::span<const std::byte> in, std::span<std::byte> out,
                     "; inner codec missing from libblosc or damaged data)");
   }
 }
+
+void swap_bytes(std::span<std::byte> v, std::size_t width) {
+  for (std::size_t i = 0; i + width <= v.size(); i += width) {
+    for (std::size_t a = 0, b = width - 1; a < b; ++a, --b) std::swap(v[i + a], v[i + b]);
+  }
+}
+
+}  // namespace detail
+
+namespace {
 
 void decode_lz4(std::span<const std::byte> in, std::span<std::byte> out,
                 std::string_view location) {
@@ -74,7 +91,7 @@ std::vector<std::byte> decode_zarr_chunk(const ZarrArrayMeta& meta,
       }
       if (!out.empty()) std::memcpy(out.data(), encoded.data(), out.size());
       break;
-    case ZarrCompressor::blosc: decode_blosc(encoded, out, location); break;
+    case ZarrCompressor::blosc: detail::decode_blosc(encoded, out, location); break;
     case ZarrCompressor::lz4: decode_lz4(encoded, out, location); break;
     case ZarrCompressor::zstd: decompress_exact(Codec::zstd, encoded, out, location, 0); break;
     case ZarrCompressor::zlib:

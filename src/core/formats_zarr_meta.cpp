@@ -1,5 +1,3 @@
-#include <cmath>
-#include <limits>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -7,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "resoct/error.hpp"
+#include "formats_zarr_json.hpp"
 #include "resoct/formats/zarr_array.hpp"
 
 namespace resoct {
@@ -14,30 +13,10 @@ namespace resoct {
 namespace {
 
 using Json = nlohmann::json;
-
-Error corrupt(std::string_view location, std::string_view key, std::string_view why) {
-  return Error(ErrorCode::corrupt,
-               std::string(location) + ": key '" + std::string(key) + "': " + std::string(why));
-}
-
-Error unsupported(std::string_view location, std::string_view key, std::string_view why) {
-  return Error(ErrorCode::unsupported,
-               std::string(location) + ": key '" + std::string(key) + "': " + std::string(why));
-}
-
-std::vector<std::uint64_t> dims(const Json& j, std::string_view location, std::string_view key) {
-  if (!j.is_array() || j.empty() || j.size() > 32) {
-    throw corrupt(location, key, "expected an array of 1..32 positive integers");
-  }
-  std::vector<std::uint64_t> out;
-  for (const Json& v : j) {
-    if (!v.is_number_unsigned() || v.get<std::uint64_t>() == 0) {
-      throw corrupt(location, key, "expected positive integers, got " + v.dump());
-    }
-    out.push_back(v.get<std::uint64_t>());
-  }
-  return out;
-}
+using detail::corrupt;
+using detail::dims;
+using detail::parse_fill;
+using detail::unsupported;
 
 void parse_dtype(const Json& j, std::string_view location, ZarrArrayMeta& m) {
   if (!j.is_string()) {
@@ -62,48 +41,6 @@ void parse_dtype(const Json& j, std::string_view location, ZarrArrayMeta& m) {
   throw unsupported(
       location, "dtype",
       "'" + d + "' is not supported (u1, i1, u2, i2, u4, i4, f4, f8 with '<' or '>')");
-}
-
-double parse_fill(const Json& j, std::string_view location, DataType t) {
-  if (j.is_null()) return 0.0;
-  double v = 0.0;
-  if (j.is_string()) {
-    const std::string s = j.get<std::string>();
-    if (s == "NaN") {
-      v = std::numeric_limits<double>::quiet_NaN();
-    } else if (s == "Infinity") {
-      v = std::numeric_limits<double>::infinity();
-    } else if (s == "-Infinity") {
-      v = -std::numeric_limits<double>::infinity();
-    } else {
-      throw corrupt(location, "fill_value", "unknown string '" + s + "'");
-    }
-  } else if (j.is_number()) {
-    v = j.get<double>();
-  } else {
-    throw corrupt(location, "fill_value", "expected a number, null or NaN/Infinity");
-  }
-  if (t != DataType::f32 && t != DataType::f64) {
-    // The integer types' value ranges (i32 and u32 values beyond 2^24 are rounded in f32, as
-    // their voxels are).
-    const double lo = t == DataType::i8    ? -128.0
-                      : t == DataType::i16 ? -32768.0
-                      : t == DataType::i32 ? -2147483648.0
-                                           : 0.0;
-    const double hi = t == DataType::u8    ? 255.0
-                      : t == DataType::i8  ? 127.0
-                      : t == DataType::u16 ? 65535.0
-                      : t == DataType::i16 ? 32767.0
-                      : t == DataType::i32 ? 2147483647.0
-                                           : 4294967295.0;
-    if (!(v >= lo && v <= hi && v == std::floor(v))) {
-      throw corrupt(location, "fill_value",
-                    "must be an integer in " + std::to_string(std::int64_t(lo)) + ".." +
-                        std::to_string(std::int64_t(hi)) + " for dtype " +
-                        std::string(to_string(t)) + ", got " + j.dump());
-    }
-  }
-  return v;
 }
 
 ZarrCompressor parse_compressor(const Json& j, std::string_view location) {
@@ -149,7 +86,7 @@ std::uint64_t ZarrArrayMeta::chunk_voxels() const {
 }
 
 std::string ZarrArrayMeta::chunk_key(std::span<const std::uint64_t> chunk_index) const {
-  std::string key;
+  std::string key = chunk_key_prefix;
   for (std::size_t i = 0; i < chunk_index.size(); ++i) {
     if (i != 0) key += dimension_separator;
     key += std::to_string(chunk_index[i]);

@@ -2,8 +2,12 @@
 #include <cstring>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "formats_zarr_shard_reader.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/ome_zarr.hpp"
+#include "resoct/formats/zarr_v3.hpp"
 
 namespace resoct {
 
@@ -11,7 +15,8 @@ namespace detail {
 
 /// One zarr array of the image and where resoct's axes sit in it.
 struct ZarrDataset {
-  std::string prefix;  // "" or "path/"
+  std::string prefix;    // "" or "path/"
+  std::string meta_key;  // prefix + ".zarray" (v2) or prefix + "zarr.json" (v3)
   ZarrArrayMeta meta;
   std::vector<std::uint64_t> grid;
   int t = -1, c = -1;
@@ -25,8 +30,10 @@ struct ZarrImage {
   std::vector<ZarrDataset> datasets;
   std::uint64_t timepoint = 0;
   std::unique_ptr<HostBrickCache> chunks;
+  std::unique_ptr<ZarrShardReader> shards;  // v3 shard indexes (LRU) and inner-chunk reads
   VoxelType type = VoxelType::u8;
   DataType data_type = DataType::u8;
+  std::string group_key;  // ".zattrs" (v2) or "zarr.json" (v3): names the image in messages
 };
 
 }  // namespace detail
@@ -41,6 +48,34 @@ std::string text_of(const std::vector<std::byte>& b) {
 }
 
 constexpr std::uint64_t kMaxMetadataBytes = 16u << 20;
+/// Decoded shard indexes kept per image (16 bytes per inner chunk).
+constexpr std::uint64_t kShardIndexCacheBytes = 32u << 20;
+
+/// The stored bytes of chunk `index` (in units of meta.chunks) of a v3 array, nullopt when
+/// absent: the chunk object itself, or for a sharded array the inner chunk read by ranges.
+/// `where` receives the chunk's location for messages.
+std::optional<std::vector<std::byte>> v3_chunk_bytes(const ZarrImage& img, const ZarrDataset& ds,
+                                                     std::span<const std::uint64_t> index,
+                                                     std::uint64_t max_bytes, std::string& where) {
+  const ZarrV3Layout& v3 = *ds.meta.v3;
+  if (v3.shard_shape.empty()) {
+    const std::string key = ds.prefix + ds.meta.chunk_key(index);
+    where = img.store->location(key);
+    return img.store->get(key, max_bytes);
+  }
+  const std::size_t rank = index.size();
+  std::vector<std::uint64_t> shard(rank);
+  std::uint64_t inner = 0, per_shard = 1;
+  for (std::size_t d = 0; d < rank; ++d) {
+    const std::uint64_t per = v3.shard_shape[d] / ds.meta.chunks[d];
+    shard[d] = index[d] / per;
+    inner = inner * per + index[d] % per;
+    per_shard *= per;
+  }
+  const std::string key = ds.prefix + ds.meta.chunk_key(shard);
+  where = img.store->location(key) + " (inner chunk " + std::to_string(inner) + ")";
+  return img.shards->inner_chunk(key, *v3.codecs[0].sharding, per_shard, inner, max_bytes);
+}
 
 /// Voxels of one decoded chunk (or fill) for (dataset, channel-chunk, spatial chunk).
 std::shared_ptr<const HostBrick> chunk(const ZarrImage& img, std::size_t ds_index,
@@ -54,33 +89,30 @@ std::shared_ptr<const HostBrick> chunk(const ZarrImage& img, std::size_t ds_inde
   for (int a = 0; a < 3; ++a) {
     if (ds.spatial[a] >= 0) index[std::size_t(ds.spatial[a])] = sc[a];
   }
-  const std::string key_text = ds.prefix + ds.meta.chunk_key(index);
   const std::uint64_t bytes = ds.meta.chunk_bytes();
   auto brick = std::make_shared<HostBrick>();
   brick->key = key;
   brick->meta.constant = false;  // HostBrickCache keeps voxels of non-constant entries only
-  auto encoded = img.store->get(key_text, 2 * bytes + 65536);
-  if (encoded) {
-    brick->voxels = decode_zarr_chunk(ds.meta, *encoded, img.store->location(key_text));
-  } else {
-    brick->voxels.resize(std::size_t(bytes));
-    const std::size_t n = std::size_t(ds.meta.chunk_voxels());
-    // fill_value is in the file's units; voxels are kept as data_mapping() says.
-    const double f = ds.meta.fill_value + data_mapping(ds.meta.data_type).offset;
-    switch (img.type) {
-      case VoxelType::u8: std::memset(brick->voxels.data(), int(f), n); break;
-      case VoxelType::u16: {
-        const auto v = std::uint16_t(f);
-        for (std::size_t i = 0; i < n; ++i) std::memcpy(brick->voxels.data() + 2 * i, &v, 2);
-        break;
-      }
-      case VoxelType::f32: {
-        const auto v = float(f);
-        for (std::size_t i = 0; i < n; ++i) std::memcpy(brick->voxels.data() + 4 * i, &v, 4);
-        break;
-      }
+  std::optional<std::vector<std::byte>> encoded;
+  if (ds.meta.v3) {
+    // Encoded v3 chunks may carry a nested shard index (16 bytes per voxel at most).
+    const std::uint64_t max = 2 * bytes + 16 * ds.meta.chunk_voxels() + 65536;
+    std::string where;
+    encoded = v3_chunk_bytes(img, ds, index, max, where);
+    if (encoded) {
+      const ZarrV3Layout& v3 = *ds.meta.v3;
+      const ZarrCodecs& codecs = v3.shard_shape.empty() ? v3.codecs : v3.codecs[0].sharding->codecs;
+      brick->voxels = decode_zarr_v3_chunk(codecs, ds.meta.chunks, img.data_type,
+                                           ds.meta.fill_value, *encoded, where);
     }
+  } else {
+    const std::string key_text = ds.prefix + ds.meta.chunk_key(index);
+    encoded = img.store->get(key_text, 2 * bytes + 65536);
+    if (encoded)
+      brick->voxels = decode_zarr_chunk(ds.meta, *encoded, img.store->location(key_text));
   }
+  if (!encoded)
+    brick->voxels = zarr_fill_voxels(img.data_type, ds.meta.fill_value, ds.meta.chunk_voxels());
   img.chunks->put(brick);
   return brick;
 }
@@ -146,23 +178,38 @@ void read_box(const ZarrImage& img, std::size_t ds_index, std::uint32_t channel,
 }
 
 Error dataset_error(const ZarrImage& img, const ZarrDataset& ds, const std::string& why) {
-  return Error(ErrorCode::corrupt, img.store->location(ds.prefix + ".zarray") + ": " + why);
+  return Error(ErrorCode::corrupt, img.store->location(ds.meta_key) + ": " + why);
 }
 
 ZarrDataset load_dataset(const ZarrImage& img, const std::string& path) {
   ZarrDataset ds;
   ds.prefix = path.empty() ? "" : path + "/";
-  const std::string key = ds.prefix + ".zarray";
+  const bool v3 = img.group_key == "zarr.json";
+  ds.meta_key = ds.prefix + (v3 ? "zarr.json" : ".zarray");
+  const std::string& key = ds.meta_key;
   const auto bytes = img.store->get(key, kMaxMetadataBytes);
   if (!bytes) {
     throw Error(ErrorCode::corrupt, img.store->location(key) + ": missing (dataset '" + path +
                                         "' of the multiscales metadata)");
   }
-  ds.meta = parse_zarr_array_meta(text_of(*bytes), img.store->location(key));
+  ds.meta = v3 ? parse_zarr_v3_array_meta(text_of(*bytes), img.store->location(key))
+               : parse_zarr_array_meta(text_of(*bytes), img.store->location(key));
   if (ds.meta.shape.size() != img.ms.axes.size()) {
     throw dataset_error(img, ds,
                         "rank " + std::to_string(ds.meta.shape.size()) + " differs from the " +
                             std::to_string(img.ms.axes.size()) + " multiscales axes");
+  }
+  if (ds.meta.v3) {
+    // NGFF 0.5: dimension_names, when given, must name the multiscales axes in order.
+    const std::vector<std::string>& names = ds.meta.v3->dimension_names;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (!names[i].empty() && names[i] != std::string(1, img.ms.axes[i])) {
+        throw Error(ErrorCode::corrupt, img.store->location(key) + ": key 'dimension_names[" +
+                                            std::to_string(i) + "]': '" + names[i] +
+                                            "' disagrees with the multiscales axis '" +
+                                            std::string(1, img.ms.axes[i]) + "'");
+      }
+    }
   }
   ds.t = img.ms.axis_index('t');
   ds.c = img.ms.axis_index('c');
@@ -184,7 +231,7 @@ ZarrDataset load_dataset(const ZarrImage& img, const std::string& path) {
 
 OmeMultiscales bare_array_axes(const ZarrArrayMeta& m, const std::string& location) {
   OmeMultiscales ms;
-  ms.version = "0.4";
+  ms.version = m.zarr_format == 3 ? "0.5" : "0.4";
   static const char* const kByRank[] = {"", "x", "yx", "zyx", "czyx", "tczyx"};
   if (m.shape.size() > 5) {
     throw Error(ErrorCode::unsupported, location + ": a bare array of rank " +
@@ -205,8 +252,29 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
   img->store = std::move(store);
   img->timepoint = o.timepoint;
   img->chunks = std::make_unique<HostBrickCache>(o.chunk_cache_bytes);
-  const auto attrs = img->store->get(".zattrs", kMaxMetadataBytes);
+  img->shards = std::make_unique<detail::ZarrShardReader>(img->store, kShardIndexCacheBytes);
+  img->group_key = ".zattrs";
   bool multiscales = false;
+  // Zarr v3 (OME-Zarr 0.5): one zarr.json per node; a group with attributes.ome, or an array.
+  if (const auto node = img->store->get("zarr.json", kMaxMetadataBytes)) {
+    img->group_key = "zarr.json";
+    const std::string text = text_of(*node);
+    const std::string loc = img->store->location("zarr.json");
+    try {
+      img->ms = parse_ome_zarr_group(text, loc);
+      multiscales = true;
+    } catch (const Error& e) {
+      // Not an image group: a bare v3 array at the root, or nothing resoct reads.
+      const auto j = nlohmann::json::parse(text, nullptr, false);
+      if (e.code() != ErrorCode::bad_magic || !j.is_object() ||
+          j.value("node_type", "") != "array") {
+        throw;
+      }
+      img->ms = bare_array_axes(parse_zarr_v3_array_meta(text, loc), loc);
+      multiscales = true;
+    }
+  }
+  const auto attrs = multiscales ? std::nullopt : img->store->get(".zattrs", kMaxMetadataBytes);
   if (attrs) {
     const std::string text = text_of(*attrs);
     try {
@@ -219,9 +287,10 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
   if (!multiscales) {
     const auto arr = img->store->get(".zarray", kMaxMetadataBytes);
     if (!arr) {
-      throw Error(ErrorCode::bad_magic,
-                  img->store->location(".zattrs") +
-                      ": no OME-Zarr image here (no 'multiscales' in .zattrs and no .zarray)");
+      throw Error(
+          ErrorCode::bad_magic,
+          img->store->location(".zattrs") +
+              ": no OME-Zarr image here (no zarr.json, no 'multiscales' in .zattrs, no .zarray)");
     }
     const std::string loc = img->store->location(".zarray");
     img->ms = bare_array_axes(parse_zarr_array_meta(text_of(*arr), loc), loc);
@@ -249,7 +318,7 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
     throw invalid_parameter("timepoint", "the image has no t axis");
   }
   if (d0.c >= 0 && d0.meta.shape[std::size_t(d0.c)] > kMaxChannels) {
-    throw Error(ErrorCode::unsupported, img->store->location(d0.prefix + ".zarray") + ": " +
+    throw Error(ErrorCode::unsupported, img->store->location(d0.meta_key) + ": " +
                                             std::to_string(d0.meta.shape[std::size_t(d0.c)]) +
                                             " channels (at most 256)");
   }
@@ -331,8 +400,8 @@ std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> st
     desc.ranges.clear();
     po.ranges_from_data = true;
   }
-  std::string name = img->store->location(".zattrs");
-  name.resize(name.size() - std::string_view("/.zattrs").size());
+  std::string name = img->store->location(img->group_key);
+  name.resize(name.size() - img->group_key.size() - 1);
   const BrickHierarchy h(desc, layout);
   std::vector<LevelBoxReader> levels(h.level_count());
   std::vector<int> level_dataset(h.level_count(), -1);

@@ -88,6 +88,7 @@ void global_init() {
 struct Attempt {
   // What the caller wants.
   bool ranged = false;
+  bool suffix = false;                      // ranged: the last `want` bytes ("bytes=-want")
   std::uint64_t offset = 0;                 // ranged: first byte wanted
   std::uint64_t want = 0;                   // ranged: bytes wanted
   std::uint64_t max_bytes = 0;              // whole object: limit
@@ -100,8 +101,10 @@ struct Attempt {
   std::uint64_t received = 0;  // body bytes of the final response
   std::uint64_t kept = 0;
   bool too_large = false;
-  bool complete_early = false;  // a 200 answer to a range request: stopped once `want` arrived
-  std::string bad_answer;       // set when the server's answer contradicts the request
+  bool complete_early = false;    // a 200 answer to a range request: stopped once `want` arrived
+  bool suffix_refused = false;    // a suffix request answered otherwise than with 206: fall back
+  std::uint64_t object_size = 0;  // suffix: the total from Content-Range
+  std::string bad_answer;         // set when the server's answer contradicts the request
 
   bool ok_status() const { return status >= 200 && status < 300; }
 };
@@ -167,6 +170,13 @@ std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
     a.kept = a.received;
     return len;
   }
+  if (a.suffix) {
+    // 200 to a suffix request: the server ignores suffix ranges. Streaming the whole object to
+    // keep its end would cost what the range was meant to save; the caller asks for the size
+    // and then a first-last range instead.
+    a.suffix_refused = true;
+    return 0;
+  }
   // 200 to a range request: the whole object streams in; keep only [offset, offset + want).
   const std::uint64_t lo = std::max(at, a.offset);
   const std::uint64_t hi = std::min<std::uint64_t>(a.received, a.offset + a.want);
@@ -196,7 +206,7 @@ bool transient(CURLcode c) {
   }
 }
 
-enum class Outcome { done, absent, retry, fail, redirect };
+enum class Outcome { done, absent, retry, fail, redirect, no_suffix };
 
 /// Redirect hops followed per attempt (libcurl's CURLOPT_MAXREDIRS before redirects were
 /// followed by hand).
@@ -282,6 +292,7 @@ struct HttpStore::Impl {
   std::mutex pool_mutex;
   std::vector<CURL*> pool;  // idle easy handles; each keeps its own keep-alive connections
   std::atomic<std::uint64_t> requests{0}, retries{0}, connections{0}, bytes{0};
+  std::atomic<bool> suffix_refused{false};  ///< a server answered a suffix range without 206
 
   ~Impl() {
     for (CURL* h : pool) curl_easy_cleanup(h);
@@ -392,7 +403,10 @@ struct HttpStore::Impl {
     curl_easy_setopt(h, CURLOPT_WRITEDATA, &a);
     if (head) curl_easy_setopt(h, CURLOPT_NOBODY, 1L);
     std::string range;
-    if (a.ranged) {
+    if (a.ranged && a.suffix) {
+      range = "-" + std::to_string(a.want);
+      curl_easy_setopt(h, CURLOPT_RANGE, range.c_str());
+    } else if (a.ranged) {
       range = std::to_string(a.offset) + "-" + std::to_string(a.offset + a.want - 1);
       curl_easy_setopt(h, CURLOPT_RANGE, range.c_str());
     }
@@ -419,6 +433,7 @@ struct HttpStore::Impl {
       why = a.bad_answer;
       return Outcome::fail;
     }
+    if (a.suffix_refused) return Outcome::no_suffix;
     if (a.complete_early) return Outcome::done;
     if (rc == CURLE_OK && a.status >= 300 && a.status < 400) {
       char* location = nullptr;
@@ -437,6 +452,9 @@ struct HttpStore::Impl {
       code = ErrorCode::io;
       why = "not found (HTTP " + std::to_string(a.status) + ")";
       return Outcome::absent;
+    }
+    if (a.suffix && (a.status == 400 || a.status == 416 || a.status == 501)) {
+      return Outcome::no_suffix;  // suffix ranges unsupported (or an empty object): fall back
     }
     if (a.status == 416) {
       code = ErrorCode::truncated;
@@ -459,7 +477,52 @@ struct HttpStore::Impl {
             std::to_string(*a.content_length) + " announced bytes";
       return Outcome::retry;
     }
+    if (a.ranged && a.suffix) return check_suffix(a, code, why);
     if (a.ranged) return check_range(a, code, why);
+    return Outcome::done;
+  }
+
+  /// "bytes FIRST-LAST/TOTAL" of a 206 answer, or nullopt (TOTAL: nullopt when '*').
+  struct ContentRange {
+    std::uint64_t first = 0, last = 0;
+    std::optional<std::uint64_t> total;
+  };
+  static std::optional<ContentRange> parse_content_range(std::string_view cr) {
+    if (!cr.starts_with("bytes ")) return std::nullopt;
+    cr.remove_prefix(6);
+    const std::size_t dash = cr.find('-'), slash = cr.find('/');
+    if (dash == std::string_view::npos || slash == std::string_view::npos || dash > slash) {
+      return std::nullopt;
+    }
+    const auto first = parse_u64(cr.substr(0, dash));
+    const auto last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
+    if (!first || !last) return std::nullopt;
+    return ContentRange{*first, *last, parse_u64(cr.substr(slash + 1))};
+  }
+
+  static Outcome check_suffix(Attempt& a, ErrorCode& code, std::string& why) {
+    if (a.status != 206) return Outcome::no_suffix;
+    const auto cr = parse_content_range(a.content_range);
+    if (!cr || !cr->total || cr->last + 1 != *cr->total || cr->first > cr->last) {
+      code = ErrorCode::io;
+      why = "206 answer with Content-Range '" + a.content_range + "' for the last " +
+            std::to_string(a.want) + " bytes";
+      return Outcome::fail;
+    }
+    if (*cr->total < a.want) {
+      code = ErrorCode::truncated;
+      why = "object of " + std::to_string(*cr->total) + " bytes is shorter than the " +
+            std::to_string(a.want) + " bytes wanted from its end";
+      return Outcome::fail;
+    }
+    if (cr->first != *cr->total - a.want || a.received != a.want) {
+      code = ErrorCode::io;
+      why = "206 answer with Content-Range '" + a.content_range + "' (" +
+            std::to_string(a.received) + " bytes) for the last " + std::to_string(a.want) +
+            " bytes";
+      return Outcome::fail;
+    }
+    a.object_size = *cr->total;
     return Outcome::done;
   }
 
@@ -520,6 +583,11 @@ struct HttpStore::Impl {
         return true;
       }
       if (o == Outcome::absent) return false;
+      if (o == Outcome::no_suffix) {
+        proto = a;
+        proto.suffix_refused = true;
+        return true;
+      }
       if (o == Outcome::retry && attempt_no < options.retries) {
         ++retries;
         std::this_thread::sleep_for(std::chrono::milliseconds(delay));
@@ -589,10 +657,10 @@ std::optional<std::vector<std::byte>> HttpStore::get(std::string_view key,
   return body;
 }
 
-void HttpStore::read_range(std::string_view key, std::uint64_t offset,
-                           std::span<std::byte> out) const {
+bool HttpStore::read_range_if_present(std::string_view key, std::uint64_t offset,
+                                      std::span<std::byte> out) const {
   check_store_key(key);
-  if (out.empty()) return;
+  if (out.empty()) return true;
   if (offset > std::numeric_limits<std::uint64_t>::max() - out.size()) {
     throw invalid_parameter("offset", "offset + size overflows");
   }
@@ -601,9 +669,54 @@ void HttpStore::read_range(std::string_view key, std::uint64_t offset,
   a.offset = offset;
   a.want = out.size();
   a.out = out;
-  if (!impl_->run(key, false, a, nullptr)) {
+  return impl_->run(key, false, a, nullptr);
+}
+
+void HttpStore::read_range(std::string_view key, std::uint64_t offset,
+                           std::span<std::byte> out) const {
+  if (!read_range_if_present(key, offset, out)) {
     throw file_error(ErrorCode::io, location(key), offset, "not found (HTTP 404)");
   }
+}
+
+std::optional<std::vector<std::byte>> HttpStore::get_range_if_present(std::string_view key,
+                                                                      std::uint64_t offset,
+                                                                      std::uint64_t size) const {
+  check_store_key(key);
+  std::vector<std::byte> out(static_cast<std::size_t>(size));
+  if (!read_range_if_present(key, offset, out)) return std::nullopt;
+  if (size == 0 && !this->size(key)) return std::nullopt;
+  return out;
+}
+
+std::optional<ObjectTail> HttpStore::get_suffix(std::string_view key, std::uint64_t size) const {
+  check_store_key(key);
+  if (size > 0 && !impl_->suffix_refused.load(std::memory_order_relaxed)) {
+    ObjectTail tail{std::vector<std::byte>(static_cast<std::size_t>(size)), 0};
+    Attempt a;
+    a.ranged = true;
+    a.suffix = true;
+    a.want = size;
+    a.out = tail.bytes;
+    if (!impl_->run(key, false, a, nullptr)) return std::nullopt;
+    if (!a.suffix_refused) {
+      tail.object_size = a.object_size;
+      return tail;
+    }
+    // Remembered: every later suffix read of this store goes straight to the fallback.
+    impl_->suffix_refused.store(true, std::memory_order_relaxed);
+  }
+  // Fallback for servers without suffix ranges: the size from HEAD, then a first-last range.
+  const std::optional<std::uint64_t> n = this->size(key);
+  if (!n) return std::nullopt;
+  if (*n < size) {
+    throw file_error(ErrorCode::truncated, location(key), 0,
+                     "object of " + std::to_string(*n) + " bytes is shorter than the " +
+                         std::to_string(size) + " bytes wanted from its end");
+  }
+  ObjectTail tail{std::vector<std::byte>(static_cast<std::size_t>(size)), *n};
+  read_range(key, *n - size, tail.bytes);
+  return tail;
 }
 
 std::vector<std::byte> HttpStore::get_range(std::string_view key, std::uint64_t offset,

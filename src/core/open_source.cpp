@@ -57,7 +57,8 @@ bool ends_with(const std::string& s, std::string_view suffix) {
 SourceKind kind_of_directory(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (fs::exists(fs::path(path) / ".zattrs", ec) || fs::exists(fs::path(path) / ".zarray", ec)) {
+  if (fs::exists(fs::path(path) / ".zattrs", ec) || fs::exists(fs::path(path) / ".zarray", ec) ||
+      fs::exists(fs::path(path) / "zarr.json", ec)) {
     return SourceKind::ome_zarr;
   }
   for (const auto& e : fs::directory_iterator(path, ec)) {
@@ -95,23 +96,26 @@ std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout
 }
 
 /// An http(s) URL: an OME-Zarr image when a URL map is given or the URL has zarr metadata below
-/// it, else a brick store file read by Range requests.
+/// it (.zattrs or .zarray: 0.4 over zarr v2; zarr.json: 0.5 over zarr v3), else a brick store file
+/// read by Range requests.
 std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout& layout) {
   if (spec.find_first_of("?#") != std::string::npos) {
     throw invalid_parameter("spec",
                             "URL '" + spec + "' has a query or fragment, which is unsupported");
   }
   std::shared_ptr<const HttpStore> store = open_http_store(spec);
-  if (spec.find(',') != std::string::npos || store->size(".zattrs") || store->size(".zarray")) {
+  if (spec.find(',') != std::string::npos || store->size(".zattrs") || store->size(".zarray") ||
+      store->size("zarr.json")) {
     return open_ome_zarr(store, layout);
   }
   // Range requests only: the store's index and metadata are read once, bricks on demand.
   auto file = open_random_access_file(spec);
   if (!has_store_magic(*file)) {
-    throw file_error(ErrorCode::invalid_argument, spec, 0,
-                     "neither an OME-Zarr image (no .zattrs/.zarray below the URL) nor a resoct "
-                     "brick store (no store magic)" +
-                         accepted());
+    throw file_error(
+        ErrorCode::invalid_argument, spec, 0,
+        "neither an OME-Zarr image (no .zattrs/.zarray/zarr.json below the URL) nor a resoct "
+        "brick store (no store magic)" +
+            accepted());
   }
   return std::make_unique<BrickStoreSource>(std::move(file));
 }
@@ -162,10 +166,11 @@ std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayou
       case SourceKind::ome_zarr: return open_ome_zarr(path, layout);
       case SourceKind::tiff: return open_tiff_stack(path, layout);
       default:
-        throw file_error(ErrorCode::invalid_argument, path, 0,
-                         "directory is neither an OME-Zarr image (.zattrs/.zarray) nor holds TIFF "
-                         "files" +
-                             accepted());
+        throw file_error(
+            ErrorCode::invalid_argument, path, 0,
+            "directory is neither an OME-Zarr image (.zattrs/.zarray/zarr.json) nor holds TIFF "
+            "files" +
+                accepted());
     }
   }
   if (!S_ISREG(st.st_mode)) {

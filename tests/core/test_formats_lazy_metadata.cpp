@@ -302,6 +302,17 @@ class CountingMemoryStore final : public ByteStore {
     const std::vector<std::byte>& b = objects.at(std::string(key));
     return {b.begin() + std::ptrdiff_t(offset), b.begin() + std::ptrdiff_t(offset + size)};
   }
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override {
+    if (!objects.contains(std::string(key))) return std::nullopt;
+    return get_range(key, offset, size);
+  }
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override {
+    const auto it = objects.find(std::string(key));
+    if (it == objects.end()) return std::nullopt;
+    return ObjectTail{get_range(key, it->second.size() - size, size), it->second.size()};
+  }
   std::string location(std::string_view key) const override {
     return "mem://huge/" + std::string(key);
   }

@@ -273,12 +273,22 @@ class CountingStore final : public ByteStore {
   explicit CountingStore(std::shared_ptr<ByteStore> inner) : inner_(std::move(inner)) {}
   std::optional<std::vector<std::byte>> get(std::string_view key,
                                             std::uint64_t max_bytes) const override {
-    if (!key.ends_with(".zarray") && !key.ends_with(".zattrs")) ++chunk_gets;
+    if (!key.ends_with(".zarray") && !key.ends_with(".zattrs") && !key.ends_with("zarr.json")) {
+      ++chunk_gets;
+    }
     return inner_->get(key, max_bytes);
   }
   std::vector<std::byte> get_range(std::string_view key, std::uint64_t offset,
                                    std::uint64_t size) const override {
     return inner_->get_range(key, offset, size);
+  }
+  std::optional<std::vector<std::byte>> get_range_if_present(std::string_view key,
+                                                             std::uint64_t offset,
+                                                             std::uint64_t size) const override {
+    return inner_->get_range_if_present(key, offset, size);
+  }
+  std::optional<ObjectTail> get_suffix(std::string_view key, std::uint64_t size) const override {
+    return inner_->get_suffix(key, size);
   }
   std::string location(std::string_view key) const override { return inner_->location(key); }
   mutable std::atomic<std::uint64_t> chunk_gets{0};

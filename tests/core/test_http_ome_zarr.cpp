@@ -67,3 +67,45 @@ TEST(HttpOmeZarr, AUrlThatIsNeitherZarrNorStoreNamesTheUrl) {
   const std::string url = server.base("ok") + "/manifest.json";
   EXPECT_RESOCT_ERROR(open_source(url), ErrorCode::invalid_argument, url);
 }
+
+namespace {
+
+const std::string& v3_data_dir() {
+  static const std::string dir =
+      test::python_generated_dir(RESOCT_BINARY_DIR "/test-data", "ome-zarr-v3",
+                                 RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr_v3.py");
+  return dir;
+}
+
+}  // namespace
+
+TEST(HttpOmeZarr, ShardedV3BrickReadsTheIndexAndOneInnerChunkNotTheShard) {
+  ASSERT_FALSE(v3_data_dir().empty());
+  HttpTestServer server(HttpTestServer::default_script(), v3_data_dir());
+  // "nosuffix" answers suffix ranges with 200: the store falls back to HEAD + a first-last range.
+  for (const char* mode : {"ok", "nosuffix"}) {
+    SCOPED_TRACE(mode);
+    const std::string name = "raw_u2_one-shard.zarr";  // one 16^3 shard of 2^3 inner 8^3 chunks
+    auto store = open_http_store(server.base(mode) + "/" + name, test::fast_http_options());
+    OmeZarrOptions o;
+    o.pyramid.threads = 1;
+    o.pyramid.eager_scan_voxels = 0;  // open reads metadata only
+    const BrickLayout layout{glm::uvec3(4), 0};
+    const auto remote = open_ome_zarr(store, layout, o);
+    const std::uint64_t after_open = store->stats().bytes;
+    std::vector<std::byte> out(layout.padded_voxels() * 2);
+    remote->read_brick(remote->hierarchy().key_from_linear(0, 0), out);
+    const std::uint64_t brick_bytes = store->stats().bytes - after_open;
+    const std::uint64_t inner = 8 * 8 * 8 * 2, index = 8 * 16 + 4;
+    const std::string shard_key =
+        "0/" + remote->array(0).chunk_key(std::vector<std::uint64_t>{0, 0, 0});
+    const auto shard_bytes =
+        open_directory_store(v3_data_dir() + "/" + name)->get(shard_key, 1 << 20);
+    ASSERT_TRUE(shard_bytes) << shard_key;
+    const std::uint64_t shard = shard_bytes->size();
+    EXPECT_EQ(brick_bytes, inner + index) << "shard of " << shard << " bytes";
+    EXPECT_LT(brick_bytes, shard / 2);
+    const auto local = open_ome_zarr(v3_data_dir() + "/" + name, layout, o);
+    test::expect_same_bricks(*local, *remote);
+  }
+}

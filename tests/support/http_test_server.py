@@ -7,7 +7,10 @@ Serves the files below ROOT on 127.0.0.1 at a free port (bound as port 0) and pr
 the test process that started it.
 
 The first path component selects a behaviour, the rest names the file below ROOT:
-  /ok/F        GET and HEAD with Range support (206 + Content-Range, 416 past the end)
+  /ok/F        GET and HEAD with Range support (206 + Content-Range, 416 past the end),
+               suffix ranges "bytes=-N" included
+  /nosuffix/F  like /ok, but answers a suffix range "bytes=-N" with 200 and the whole file (as
+               servers that implement only first-last ranges do)
   /norange/F   ignores Range headers (always 200 with the whole file)
   /missing/F   404
   /flaky/F     500 for the first two requests of each path, then like /ok
@@ -130,7 +133,7 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 self.wfile.flush()
             self.close_connection = True
             return
-        if mode not in ("ok", "flaky", "norange"):
+        if mode not in ("ok", "flaky", "norange", "nosuffix"):
             return self.send_bytes(400, b"unknown mode", send_body=send_body)
         rng = self.headers.get("Range")
         if mode == "norange" or rng is None:
@@ -141,6 +144,14 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 self.end_headers()
                 return
             return self.send_bytes(200, read(0, size), [("Accept-Ranges", "bytes")])
+        suffix = re.fullmatch(r"bytes=-(\d+)", rng.strip())
+        if suffix and mode == "nosuffix":
+            return self.send_bytes(200, read(0, size), [("Accept-Ranges", "bytes")], send_body)
+        if suffix and int(suffix.group(1)) > 0 and size > 0:
+            first = max(0, size - int(suffix.group(1)))
+            return self.send_bytes(206, read(first, size - first),
+                                   [("Content-Range", "bytes %d-%d/%d" % (first, size - 1, size))],
+                                   send_body)
         m = re.fullmatch(r"bytes=(\d+)-(\d*)", rng.strip())
         if not m:
             return self.send_bytes(400, b"bad range", send_body=send_body)

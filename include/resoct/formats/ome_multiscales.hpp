@@ -1,8 +1,10 @@
 #pragma once
 /// \file
-/// OME-NGFF 0.4 image metadata (the `.zattrs` of an OME-Zarr image group): the `multiscales`
-/// levels with their coordinate transformations, the axes, and `omero` channel display
-/// metadata when present.
+/// OME-NGFF image metadata: the `.zattrs` of an OME-Zarr 0.4 image group (zarr v2) or the
+/// `attributes.ome` of an OME-Zarr 0.5 group `zarr.json` (zarr v3): the `multiscales` levels with
+/// their coordinate transformations, the axes, and `omero` channel display metadata when
+/// present. Both versions share one structure; 0.5 moves it under `attributes.ome` and its
+/// version to `attributes.ome.version`.
 
 #include <optional>
 #include <string>
@@ -30,7 +32,7 @@ struct OmeChannel {
 };
 
 struct OmeMultiscales {
-  std::string version;  ///< "0.4"
+  std::string version;  ///< "0.4" or "0.5"
   std::string name;
   /// Axis names in array order, each one of 't', 'c', 'z', 'y', 'x', in that relative order
   /// (NGFF: time, then channel, then space), each at most once, at least one spatial.
@@ -51,5 +53,13 @@ struct OmeMultiscales {
 /// Error(bad_magic) when there is no `multiscales` key (not an OME-Zarr image).
 /// Thread-safety: a pure function.
 OmeMultiscales parse_ome_multiscales(std::string_view json, std::string_view location);
+
+/// Parses the `zarr.json` of an OME-Zarr 0.5 image group (zarr_format 3, node_type "group",
+/// `attributes.ome` with version "0.5"); keys in messages start with "attributes.ome.".
+/// Throws Error(bad_magic) when it is not a group or has no `attributes.ome` /
+/// `attributes.ome.multiscales`, Error(unsupported_version) for zarr_format != 3 or an
+/// `attributes.ome.version` other than "0.5", and what parse_ome_multiscales throws for the
+/// rest. Thread-safety: a pure function.
+OmeMultiscales parse_ome_zarr_group(std::string_view json, std::string_view location);
 
 }  // namespace resoct

@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// OME-Zarr images (NGFF 0.4 over zarr v2) as brick sources, read through a ByteStore, so the
+/// OME-Zarr images (NGFF 0.4 over zarr v2, NGFF 0.5 over zarr v3 with sharding; docs/formats.md)
+/// as brick sources, read through a ByteStore, so the
 /// same reader serves a local directory and HTTP servers.
 ///
 /// Mapping: the spatial axes z, y, x become resoct's z, y, x (an absent one has extent 1), `c`

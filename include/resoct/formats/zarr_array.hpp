@@ -1,6 +1,8 @@
 #pragma once
 /// \file
-/// Zarr v2 arrays: the `.zarray` metadata and the decoding of one stored chunk. Parsers are free
+/// Zarr arrays: the `.zarray` metadata (v2) and the decoding of one stored v2 chunk. The same
+/// ZarrArrayMeta describes a v3 array (zarr_v3.hpp parses its `zarr.json` and decodes its
+/// codec pipeline; `v3` then holds the codecs and the shard shape). Parsers are free
 /// functions over bytes so that fuzz targets and the HTTP reader call exactly what the zarr
 /// source calls. Supported: dtypes u1, i1, u2, i2, u4, i4, f4, f8 of either byte order (kept
 /// through data_mapping(), voxel_type.hpp: i1 / i2 exactly with an offset, u4, i4 and f8 as f32,
@@ -10,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -19,6 +22,8 @@
 #include "resoct/voxel_type.hpp"
 
 namespace resoct {
+
+struct ZarrV3Layout;  // zarr_v3.hpp
 
 /// How a chunk is compressed (numcodecs ids).
 enum class ZarrCompressor : std::uint8_t { none, blosc, lz4, zstd, zlib, gzip };
@@ -41,6 +46,13 @@ struct ZarrArrayMeta {
   ZarrCompressor compressor = ZarrCompressor::none;
   double fill_value = 0.0;         ///< value of voxels in missing chunks (null: 0), file units
   char dimension_separator = '.';  ///< '.' or '/' between chunk indices in chunk keys
+  int zarr_format = 2;             ///< 2 or 3
+  /// Before the chunk indices in a chunk key: "" (v2, and v3 "v2" encoding), "c/" or "c." (v3
+  /// "default" encoding).
+  std::string chunk_key_prefix;
+  /// v3 only (null for v2): codec pipeline, shard shape, dimension names. `compressor` and
+  /// `endian` are then unused.
+  std::shared_ptr<const ZarrV3Layout> v3;
 
   /// Chunks per dimension: ceil(shape / chunks).
   std::vector<std::uint64_t> chunk_grid() const;
@@ -50,7 +62,8 @@ struct ZarrArrayMeta {
   std::uint64_t chunk_bytes() const { return chunk_voxels() * voxel_size(type); }
   /// Bytes of one chunk as stored values before compression: chunk_voxels() * data_size(data_type).
   std::uint64_t stored_chunk_bytes() const { return chunk_voxels() * data_size(data_type); }
-  /// The store key of a chunk relative to the array: "2.0.13" or "2/0/13".
+  /// The store key of a chunk relative to the array: "2.0.13", "2/0/13", "c/2/0/13". For a
+  /// sharded v3 array `chunk_index` indexes the chunk grid (shards), not inner chunks.
   std::string chunk_key(std::span<const std::uint64_t> chunk_index) const;
 };
 
