@@ -2,7 +2,8 @@
 /// \file
 /// A ByteStore over one or more HTTP(S) servers (libcurl): keep-alive connection reuse across
 /// threads, timeouts, retries with exponential backoff, Range requests, and a URL map that lets
-/// key prefixes (zarr levels, channels, a brick store file) live on different hosts.
+/// key prefixes (zarr levels, channels, a brick store file) live on different hosts. Requests may
+/// be SigV4-signed (HttpOptions::aws_sigv4): S3 stores (s3_store.hpp) are HttpStores.
 /// Spec and behaviour: docs/http.md.
 
 #include <cstdint>

@@ -157,10 +157,7 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
       return 0;
     }
   } else if (name == "content-range") {
-    std::string_view v = value;
-    while (!v.empty() && v.front() == ' ') v.remove_prefix(1);
-    while (!v.empty() && std::isspace(static_cast<unsigned char>(v.back()))) v.remove_suffix(1);
-    a.content_range = std::string(v);
+    a.content_range = std::string(trim(value));
   } else if (name == "x-amz-error-code") {
     a.error_code = detail::s3_error_code("<Error><Code>" + std::string(trim(value)) + "</Code>");
   }

@@ -140,7 +140,13 @@ std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout
 /// An s3://bucket/key spec: as open_url, in an S3-compatible object store.
 std::unique_ptr<BrickSource> open_s3(const std::string& spec, const BrickLayout& layout,
                                      const SourceOptions& options) {
-  const S3Config config = resolve_s3_config(options.s3);
+  S3Config config;
+  try {
+    config = resolve_s3_config(options.s3);
+  } catch (const Error& e) {
+    // The configuration comes from elsewhere (options, environment); say which spec needed it.
+    throw Error(e.code(), "'" + spec + "': " + e.what());
+  }
   std::shared_ptr<const HttpStore> store = open_s3_store(spec, config, options.http);
   if (auto zarr = open_if_zarr(store, true, layout)) return zarr;
   return open_brick_store_file(open_s3_object(spec, config, options.http), spec);

@@ -79,6 +79,10 @@ TEST(S3Config, BadEndpointsAndRegionsAreErrorsNamingTheirSource) {
                       ErrorCode::invalid_argument, "AWS_ENDPOINT_URL_S3");
   EXPECT_RESOCT_ERROR(resolve_s3_config({}, env_of({{"AWS_REGION", "eu/west"}})),
                       ErrorCode::invalid_argument, "AWS_REGION");
+  SourceOptions bad;
+  bad.s3.endpoint = "not a url";
+  EXPECT_RESOCT_ERROR(open_source("s3://bucket/x.zarr", {}, bad), ErrorCode::invalid_argument,
+                      "'s3://bucket/x.zarr': parameter 's3 endpoint': 'not a url'");
 }
 
 TEST(S3Config, CredentialsComeFromOptionsThenEnvironmentThenFile) {

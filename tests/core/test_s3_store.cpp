@@ -127,6 +127,7 @@ TEST_F(S3Store, SignedRangeReadsReturnTheFileBytes) {
   EXPECT_RESOCT_ERROR(store->get_range("cells.rbs", local.size() - 5, 10), ErrorCode::truncated,
                       "cells.rbs");
   EXPECT_EQ(store->stats().retries, 0u);
+  EXPECT_EQ(store->stats().connections, 1u);  // keep-alive: signed requests share a connection
 }
 
 TEST_F(S3Store, AWrongSecretIsOneClearErrorNamingBucketAndKey) {
