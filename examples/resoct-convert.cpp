@@ -29,6 +29,7 @@
 #include "support/cli_parse.hpp"
 #include "support/output_path.hpp"
 #include "support/progress.hpp"
+#include "support/source_options.hpp"
 #include "support/tool_main.hpp"
 
 namespace {
@@ -40,6 +41,7 @@ constexpr const char* kTool = "resoct-convert";
 constexpr const char* kRawTypes = "u8, u16, f32, i8, i16, i32, u32, f64";
 
 struct Args {
+  SourceOptions source;
   std::string input, output;
   // Raw input.
   std::string dims, type, endian = "little", spacing, range;
@@ -212,13 +214,13 @@ int convert(const Args& a, const CLI::App& app) {
       }
     }
     src = make_procedural_source(a.input, layout);
-  } else if (kind == SourceKind::unknown || raw_given) {
+  } else if ((kind == SourceKind::unknown && !is_remote_spec(a.input)) || raw_given) {
     // Raw options make any file raw (e.g. a header skipped with --offset).
     src = open_raw(a, app, layout);
   } else {
     std::fprintf(stderr, "%s: reading %s (coarser levels are built while writing)\n", kTool,
                  a.input.c_str());
-    src = open_source(a.input, layout);
+    src = open_source(a.input, layout, a.source);
   }
 
   std::unique_ptr<Progress> progress;
@@ -255,6 +257,7 @@ int main(int argc, char** argv) {
                  std::string(kSourceSpecForms) + ", or a raw file (needs --dims and --type)")
       ->required();
   app.add_option("output", a.output, "brick store to write (replaced atomically)")->required();
+  add_source_options(app, a.source);
   auto* raw = "Raw input";
   app.add_option("--dims", a.dims, "raw: voxels per axis, WxHxD")->group(raw);
   app.add_option("--type", a.type,

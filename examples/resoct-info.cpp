@@ -12,6 +12,7 @@
 #include "resoct/brick_store.hpp"
 #include "resoct/open_source.hpp"
 #include "support/cli_parse.hpp"
+#include "support/source_options.hpp"
 #include "support/tool_main.hpp"
 
 namespace {
@@ -209,8 +210,8 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
       stats != nullptr ? &total : nullptr);
 }
 
-int info(const std::string& spec, bool as_json) {
-  const std::unique_ptr<BrickSource> src = open_source(spec);
+int info(const std::string& spec, const SourceOptions& options, bool as_json) {
+  const std::unique_ptr<BrickSource> src = open_source(spec, {}, options);
   const auto* store = dynamic_cast<const BrickStoreSource*>(src.get());
   const SourceKind kind = detect_source_kind(spec);
   if (as_json) {
@@ -232,11 +233,13 @@ int main(int argc, char** argv) {
   bool as_json = false;
   app.add_option("source", spec, std::string(kSourceSpecForms))->required();
   app.add_flag("--json", as_json, "print JSON instead of text");
+  SourceOptions options;
+  add_source_options(app, options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  return run_tool(kTool, [&] { return info(spec, as_json); });
+  return run_tool(kTool, [&] { return info(spec, options, as_json); });
 }

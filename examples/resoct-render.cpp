@@ -20,6 +20,7 @@
 #include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
 #include "support/cli_parse.hpp"
+#include "support/source_options.hpp"
 #include "support/output_path.hpp"
 #include "support/tool_main.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
@@ -34,6 +35,7 @@ using namespace resoct;
 
 struct Args {
   std::string volume;
+  resoct::SourceOptions source;
   std::string scene;
   std::string backend = "cpu";
   std::string device;
@@ -178,7 +180,7 @@ int run(const Args& a) {
   Scene scene = load_scene(a.scene);
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
-  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume)), o);
+  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
   renderer.set_failure_callback([](const LoadFailure& f) {
     std::fprintf(stderr, "resoct-render: warning: %s\n", f.message.c_str());
   });
@@ -248,6 +250,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Render a volume with the residency octree renderer"};
   Args a;
   app.add_option("--volume", a.volume, std::string(kSourceSpecForms) + " (required)");
+  resoct::tools::add_source_options(app, a.source);
   app.add_option("--scene", a.scene, "scene JSON (docs/scene.md) (required)");
   app.add_option("--backend", a.backend, "cpu | vulkan (when built) | registered backend name")
       ->capture_default_str();

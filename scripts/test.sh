@@ -11,4 +11,7 @@ bash scripts/build.sh release
 # install-deps.sh installs lavapipe, so Vulkan must work here: a Vulkan test that would skip for
 # want of a driver fails instead (docs/testing.md). RESOCT_REQUIRE_VULKAN=0 opts out.
 export RESOCT_REQUIRE_VULKAN="${RESOCT_REQUIRE_VULKAN:-1}"
+# Likewise the npm test tools installed above (the S3 tests' s3rver): their tests fail rather than
+# skip when the tools are missing. RESOCT_REQUIRE_NPM=0 opts out.
+export RESOCT_REQUIRE_NPM="${RESOCT_REQUIRE_NPM:-1}"
 ctest --preset release -j "${RESOCT_JOBS:-2}" "$@"

@@ -2,7 +2,8 @@
 /// \file
 /// A ByteStore over one or more HTTP(S) servers (libcurl): keep-alive connection reuse across
 /// threads, timeouts, retries with exponential backoff, Range requests, and a URL map that lets
-/// key prefixes (zarr levels, channels, a brick store file) live on different hosts.
+/// key prefixes (zarr levels, channels, a brick store file) live on different hosts. Requests may
+/// be SigV4-signed (HttpOptions::aws_sigv4): S3 stores (s3_store.hpp) are HttpStores.
 /// Spec and behaviour: docs/http.md.
 
 #include <cstdint>
@@ -34,6 +35,18 @@ struct UrlMap {
 /// is not a valid store key (check_store_key).
 UrlMap parse_url_map(std::string_view spec);
 
+/// AWS Signature Version 4 for every request (S3 and S3-compatible stores: MinIO, Ceph, GCS
+/// interoperability), computed by libcurl (CURLOPT_AWS_SIGV4 "aws:amz:<region>:<service>").
+/// s3_store.hpp fills it from options, the environment or a credentials file. The secret and the
+/// token never appear in messages.
+struct AwsSigV4 {
+  std::string region = "us-east-1";
+  std::string service = "s3";
+  std::string access_key_id;
+  std::string secret_access_key;
+  std::string session_token;  ///< temporary credentials: sent, and signed, as x-amz-security-token
+};
+
 /// Network behaviour of an HttpStore. Every limit bounds one attempt; a request makes at most
 /// 1 + retries attempts, so it ends within (1 + retries) * total_timeout_ms plus the backoff.
 struct HttpOptions {
@@ -56,6 +69,8 @@ struct HttpOptions {
   /// origin (another host or port, https to http, another scheme such as file://) fails with
   /// Error(invalid_argument) naming the URL and the target; it is never followed.
   std::vector<std::string> redirect_origins;
+  /// Sign requests (S3); unsigned (anonymous) when empty.
+  std::optional<AwsSigV4> aws_sigv4;
   /// Throws Error(invalid_argument) naming the field.
   void validate() const;
 };
@@ -79,10 +94,12 @@ class HttpStore final : public ByteStore {
   HttpStore(const HttpStore&) = delete;
   HttpStore& operator=(const HttpStore&) = delete;
 
-  /// GET of the whole object. nullopt for HTTP 404/410. Throws Error(out_of_range) naming the
-  /// URL when the body exceeds max_bytes (the transfer is aborted as soon as Content-Length or
-  /// the received bytes exceed it), Error(truncated) naming the URL when the body is shorter
-  /// than its Content-Length, Error(io) naming the URL and the reason for any other failure.
+  /// GET of the whole object. nullopt for HTTP 404/410, except a 404 whose S3 error code is
+  /// NoSuchBucket (a missing bucket is a mistake, not an absent zarr chunk: Error(io)). Throws
+  /// Error(out_of_range) naming the URL when the body exceeds max_bytes (the transfer is aborted as
+  /// soon as Content-Length or the received bytes exceed it), Error(truncated) naming the URL when
+  /// the body is shorter than its Content-Length, Error(io) naming the URL and the reason for any
+  /// other failure.
   std::optional<std::vector<std::byte>> get(std::string_view key,
                                             std::uint64_t max_bytes) const override;
   /// GET with "Range: bytes=offset-(offset+size-1)". A 206 answer must carry the matching

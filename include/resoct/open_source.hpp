@@ -7,6 +7,8 @@
 #include <string_view>
 
 #include "resoct/brick_source.hpp"
+#include "resoct/http_store.hpp"
+#include "resoct/s3_store.hpp"
 
 namespace resoct {
 
@@ -14,8 +16,9 @@ namespace resoct {
 inline constexpr std::string_view kSourceSpecForms =
     "procedural:NAME[:WxHxD[:CHANNELS]], a resoct brick store (.rbs), an OME-Zarr directory, "
     "a NIfTI-1 file (.nii, .nii.gz), an NRRD file (.nrrd, .nhdr), a TIFF file or a directory of "
-    "TIFF files (.tif, .tiff), stack:SPEC+SPEC+... (sources on one grid as channels), or an "
-    "http(s):// URL of a brick store or an OME-Zarr image (URL[,PREFIX=URL]..., docs/http.md)";
+    "TIFF files (.tif, .tiff), stack:SPEC+SPEC+... (sources on one grid as channels), an "
+    "http(s):// URL of a brick store or an OME-Zarr image (URL[,PREFIX=URL]..., docs/http.md), or "
+    "an s3://bucket/key of one (S3-compatible object stores, docs/http.md)";
 
 /// What a spec names, decided from its prefix, the file's magic bytes (brick store), the
 /// directory's content (OME-Zarr: a .zattrs or .zarray; TIFF: .tif/.tiff files) or the file
@@ -38,6 +41,12 @@ std::string_view to_string(SourceKind k) noexcept;
 /// A path that does not exist is `unknown`. Thread-safety: a pure function.
 SourceKind detect_source_kind(std::string_view spec);
 
+/// How remote sources are reached (network behaviour, S3 endpoint and credentials).
+struct SourceOptions {
+  HttpOptions http;
+  S3Options s3;  ///< empty fields are taken from the environment (resolve_s3_config)
+};
+
 /// Opens the source `spec` names:
 /// - `procedural:...` gives make_procedural_source(spec, layout);
 /// - a brick store, recognized by its magic bytes (not its extension), gives a
@@ -49,7 +58,9 @@ SourceKind detect_source_kind(std::string_view spec);
 /// - an http:// or https:// URL (default HttpOptions, docs/http.md): an OME-Zarr image when the
 ///   URL has a `.zattrs` or `.zarray` below it, read through an HttpStore (a URL map
 ///   "URL,PREFIX=URL,..." routes key prefixes to other hosts and always means OME-Zarr), else a
-///   brick store read by Range requests (recognized by its magic bytes).
+///   brick store read by Range requests (recognized by its magic bytes);
+/// - an s3://bucket/key spec: the same, from an S3-compatible object store (options.s3,
+///   docs/http.md "S3-compatible object stores"); a missing bucket is an Error(io) saying so.
 /// Raw files need extent, type and byte order, so they are not accepted here: open them with
 /// open_raw_volume() and wrap the result in an InMemorySource (or convert them with
 /// resoct-convert).
@@ -59,5 +70,8 @@ SourceKind detect_source_kind(std::string_view spec);
 /// message lists the accepted forms when the spec itself is not understood.
 /// Thread-safety: a pure function; the returned source is thread-safe as BrickSource requires.
 std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayout& layout = {});
+/// As above with explicit options for remote sources (the parts of a stack: spec get them too).
+std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayout& layout,
+                                         const SourceOptions& options);
 
 }  // namespace resoct

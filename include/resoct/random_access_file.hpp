@@ -13,6 +13,7 @@
 namespace resoct {
 
 struct HttpOptions;
+class HttpStore;
 
 /// Thread-safety: implementations allow read_at(), size() and path() from any number of threads
 /// at once (nothing shares a file position).
@@ -35,6 +36,10 @@ class RandomAccessFile {
 /// path or URL when it does not exist or cannot be read.
 std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url,
                                                           const HttpOptions& http);
+/// The object `key` of `store` (HEAD for its size, then Range requests); `name` is its path()
+/// ("s3://bucket/key"), which messages name. Throws as above.
+std::unique_ptr<RandomAccessFile> open_http_object(std::shared_ptr<const HttpStore> store,
+                                                   std::string key, std::string name);
 /// As above with default HttpOptions.
 std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url);
 

@@ -13,6 +13,8 @@
 #include <curl/curl.h>
 
 #include "http_origin.hpp"
+#include "percent_encoding.hpp"
+#include "s3_error_code.hpp"
 #include "resoct/error.hpp"
 
 namespace resoct {
@@ -49,26 +51,14 @@ bool prefix_matches(std::string_view prefix, std::string_view key) {
   return key.starts_with(prefix) && (key.size() == prefix.size() || key[prefix.size()] == '/');
 }
 
-std::string percent_encode(std::string_view key) {
-  static constexpr char kHex[] = "0123456789ABCDEF";
-  std::string out;
-  out.reserve(key.size());
-  for (char ch : key) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (std::isalnum(c) || c == '.' || c == '_' || c == '~' || c == '-' || c == '/') {
-      out.push_back(ch);
-    } else {
-      out.push_back('%');
-      out.push_back(kHex[c >> 4]);
-      out.push_back(kHex[c & 15]);
-    }
-  }
-  return out;
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
 }
 
 std::optional<std::uint64_t> parse_u64(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  s = trim(s);
   std::uint64_t v = 0;
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size() || s.empty()) return std::nullopt;
@@ -82,6 +72,20 @@ void global_init() {
       throw Error(ErrorCode::io, "libcurl: curl_global_init failed");
     }
   });
+}
+
+/// Bytes of an error answer kept: an S3 <Error> document names its code near the start.
+constexpr std::size_t kErrorBodyBytes = 4096;
+
+/// SHA-256 of the empty body: every request here is a GET or HEAD. S3 requires the payload
+/// hash as an x-amz-content-sha256 header on signed requests, which libcurl 7.88 does not add
+/// by itself; given as a header it is also what libcurl signs.
+constexpr const char* kEmptyPayloadSha256 =
+    "x-amz-content-sha256: e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855";
+
+bool has_control_character(std::string_view s) {
+  return std::any_of(s.begin(), s.end(),
+                     [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
 }
 
 /// State of one attempt, shared with libcurl's callbacks.
@@ -105,8 +109,26 @@ struct Attempt {
   bool suffix_refused = false;    // a suffix request answered otherwise than with 206: fall back
   std::uint64_t object_size = 0;  // suffix: the total from Content-Range
   std::string bad_answer;         // set when the server's answer contradicts the request
+  std::string error_body;         // the first bytes of an error answer (an S3 <Error> document)
+  std::string error_code;         // an x-amz-error-code header (S3 stores; HEAD answers too)
 
   bool ok_status() const { return status >= 200 && status < 300; }
+
+  /// The S3 error code of the answer: the header's, else the body's ("" for none).
+  std::string s3_code() const {
+    return error_code.empty() ? detail::s3_error_code(error_body) : error_code;
+  }
+  /// "HTTP 403", with the S3 error code and advice when the answer has one:
+  /// "HTTP 403 SignatureDoesNotMatch: the secret access key is wrong".
+  std::string status_text() const {
+    std::string text = "HTTP " + std::to_string(status);
+    const std::string code = s3_code();
+    if (code.empty()) return text;
+    text += " " + code;
+    const std::string_view advice = detail::s3_error_advice(code);
+    if (!advice.empty()) text += ": " + std::string(advice);
+    return text;
+  }
 };
 
 std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
@@ -117,6 +139,7 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
     // A new response (after a redirect or "100 Continue"): forget the previous headers.
     a.content_length.reset();
     a.content_range.clear();
+    a.error_code.clear();
     const std::size_t sp = line.find(' ');
     a.status = 0;
     if (sp != std::string_view::npos) {
@@ -137,10 +160,9 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
       return 0;
     }
   } else if (name == "content-range") {
-    std::string_view v = value;
-    while (!v.empty() && v.front() == ' ') v.remove_prefix(1);
-    while (!v.empty() && std::isspace(static_cast<unsigned char>(v.back()))) v.remove_suffix(1);
-    a.content_range = std::string(v);
+    a.content_range = std::string(trim(value));
+  } else if (name == "x-amz-error-code") {
+    a.error_code = detail::s3_error_code("<Error><Code>" + std::string(trim(value)) + "</Code>");
   }
   return len;
 }
@@ -151,7 +173,11 @@ std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
   const auto* bytes = reinterpret_cast<const std::byte*>(data);
   const std::uint64_t at = a.received;
   a.received += len;
-  if (!a.ok_status()) return len;  // an error page; only the status matters
+  if (!a.ok_status()) {
+    // An error page: only the status matters, and an S3 error code if the page has one.
+    a.error_body.append(data, std::min<std::size_t>(len, kErrorBodyBytes - a.error_body.size()));
+    return len;
+  }
   if (!a.ranged) {
     if (a.received > a.max_bytes) {
       a.too_large = true;
@@ -281,6 +307,35 @@ void HttpOptions::validate() const {
       throw invalid_parameter("redirect_origins", "'" + url + "' is not an http(s)://host URL");
     }
   }
+  if (aws_sigv4) {
+    const AwsSigV4& s = *aws_sigv4;
+    // Both go into "aws:amz:<region>:<service>", which libcurl splits at ':'.
+    const auto label = [](const std::string& v) {
+      return !v.empty() && v.size() <= 64 && std::all_of(v.begin(), v.end(), [](char c) {
+        return std::islower(static_cast<unsigned char>(c)) ||
+               std::isdigit(static_cast<unsigned char>(c)) || c == '-';
+      });
+    };
+    if (!label(s.region)) {
+      throw invalid_parameter("aws_sigv4.region", "'" + s.region + "' is not a region name");
+    }
+    if (!label(s.service)) {
+      throw invalid_parameter("aws_sigv4.service", "'" + s.service + "' is not a service name");
+    }
+    // Secrets are never echoed, only named.
+    if (s.access_key_id.empty() || has_control_character(s.access_key_id) ||
+        s.access_key_id.find(':') != std::string::npos) {
+      throw invalid_parameter("aws_sigv4.access_key_id",
+                              "must be non-empty, without ':' or control characters");
+    }
+    if (s.secret_access_key.empty() || has_control_character(s.secret_access_key)) {
+      throw invalid_parameter("aws_sigv4.secret_access_key",
+                              "must be non-empty, without control characters");
+    }
+    if (has_control_character(s.session_token)) {
+      throw invalid_parameter("aws_sigv4.session_token", "must not contain control characters");
+    }
+  }
 }
 
 struct HttpStore::Impl {
@@ -331,7 +386,7 @@ struct HttpStore::Impl {
         best_len = prefix.size();
       }
     }
-    return *best + "/" + percent_encode(key);
+    return *best + "/" + detail::percent_encode_key(key);
   }
 
   /// Whether a redirect may lead to `target`: only to an origin (scheme, host, port) that the
@@ -377,6 +432,27 @@ struct HttpStore::Impl {
     }
   }
 
+  /// Sets the SigV4 options on `h` when the store signs; returns the extra headers, which must
+  /// outlive the request (nullptr when unsigned).
+  curl_slist* sign(CURL* h) const {
+    if (!options.aws_sigv4) return nullptr;
+    const AwsSigV4& s = *options.aws_sigv4;
+    const std::string provider = "aws:amz:" + s.region + ":" + s.service;
+    curl_easy_setopt(h, CURLOPT_AWS_SIGV4, provider.c_str());  // libcurl copies strings
+    curl_easy_setopt(h, CURLOPT_USERNAME, s.access_key_id.c_str());
+    curl_easy_setopt(h, CURLOPT_PASSWORD, s.secret_access_key.c_str());
+    curl_slist* list = curl_slist_append(nullptr, kEmptyPayloadSha256);
+    if (list != nullptr && !s.session_token.empty()) {
+      const std::string token = "x-amz-security-token: " + s.session_token;
+      curl_slist* more = curl_slist_append(list, token.c_str());
+      if (more == nullptr) curl_slist_free_all(list);
+      list = more;
+    }
+    if (list == nullptr) throw Error(ErrorCode::out_of_memory, "libcurl: curl_slist_append failed");
+    curl_easy_setopt(h, CURLOPT_HTTPHEADER, list);
+    return list;
+  }
+
   /// One request, without following redirects.
   Outcome attempt_one(CURL* h, const std::string& url, bool head, Attempt& a, ErrorCode& code,
                       std::string& why) {
@@ -412,6 +488,9 @@ struct HttpStore::Impl {
     }
     char curl_error[CURL_ERROR_SIZE] = {};
     curl_easy_setopt(h, CURLOPT_ERRORBUFFER, curl_error);
+    // Signed anew for each hop and attempt: the signature covers the URL and the time.
+    const std::unique_ptr<curl_slist, decltype(&curl_slist_free_all)> headers(sign(h),
+                                                                              curl_slist_free_all);
 
     const CURLcode rc = curl_easy_perform(h);
     ++requests;
@@ -448,6 +527,11 @@ struct HttpStore::Impl {
       why = std::string(rc == CURLE_PARTIAL_FILE ? "truncated body: " : "") + text;
       return transient(rc) ? Outcome::retry : Outcome::fail;
     }
+    if (a.status == 404 && a.s3_code() == "NoSuchBucket") {
+      code = ErrorCode::io;
+      why = a.status_text();
+      return Outcome::fail;
+    }
     if (a.status == 404 || a.status == 410) {
       code = ErrorCode::io;
       why = "not found (HTTP " + std::to_string(a.status) + ")";
@@ -463,12 +547,12 @@ struct HttpStore::Impl {
     }
     if (a.status == 408 || a.status == 429 || (a.status >= 500 && a.status < 600)) {
       code = ErrorCode::io;
-      why = "HTTP " + std::to_string(a.status);
+      why = a.status_text();
       return Outcome::retry;
     }
     if (!a.ok_status()) {
       code = ErrorCode::io;
-      why = "HTTP " + std::to_string(a.status);
+      why = a.status_text();
       return Outcome::fail;
     }
     if (!head && a.content_length && *a.content_length != a.received) {

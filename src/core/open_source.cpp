@@ -20,6 +20,8 @@
 #include "resoct/formats/tiff_stack.hpp"
 #include "resoct/http_store.hpp"
 #include "resoct/procedural_source.hpp"
+#include "resoct/random_access_file.hpp"
+#include "resoct/s3_store.hpp"
 #include "resoct/store/format.hpp"
 
 namespace resoct {
@@ -77,13 +79,14 @@ SourceKind kind_of_file(const std::string& path) {
   return SourceKind::unknown;
 }
 
-std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout& layout) {
+std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout& layout,
+                                        const SourceOptions& options) {
   std::vector<std::shared_ptr<const BrickSource>> parts;
   while (true) {
     const std::size_t plus = list.find('+');
     const std::string_view part = list.substr(0, plus);
     if (part.empty()) throw invalid_parameter("spec", "empty part in a stack: spec" + accepted());
-    parts.push_back(open_source(part, layout));
+    parts.push_back(open_source(part, layout, options));
     if (plus == std::string_view::npos) break;
     list.remove_prefix(plus + 1);
   }
@@ -95,29 +98,61 @@ std::unique_ptr<BrickSource> open_stack(std::string_view list, const BrickLayout
   return stack_channels(std::move(parts), std::move(name));
 }
 
-/// An http(s) URL: an OME-Zarr image when a URL map is given or the URL has zarr metadata below
-/// it (.zattrs or .zarray: 0.4 over zarr v2; zarr.json: 0.5 over zarr v3), else a brick store file
-/// read by Range requests.
-std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout& layout) {
-  if (spec.find_first_of("?#") != std::string::npos) {
-    throw invalid_parameter("spec",
-                            "URL '" + spec + "' has a query or fragment, which is unsupported");
+/// An OME-Zarr image when `store` has zarr metadata at its root, else nullptr. S3 asks with GET:
+/// a 404 for a missing bucket carries the store's error code in its body, so that it fails
+/// there (HttpStore::get) instead of reading as "no such object" (a HEAD answer has no body).
+std::unique_ptr<BrickSource> open_if_zarr(const std::shared_ptr<const HttpStore>& store,
+                                          bool probe_with_get, const BrickLayout& layout) {
+  constexpr std::uint64_t kProbeBytes = 64 << 20;  // zarr metadata is small
+  // .zattrs / .zarray: 0.4 over zarr v2; zarr.json: 0.5 over zarr v3.
+  for (const char* key : {".zattrs", ".zarray", "zarr.json"}) {
+    const bool found =
+        probe_with_get ? store->get(key, kProbeBytes).has_value() : store->size(key).has_value();
+    if (found) return open_ome_zarr(store, layout);
   }
-  std::shared_ptr<const HttpStore> store = open_http_store(spec);
-  if (spec.find(',') != std::string::npos || store->size(".zattrs") || store->size(".zarray") ||
-      store->size("zarr.json")) {
-    return open_ome_zarr(store, layout);
-  }
-  // Range requests only: the store's index and metadata are read once, bricks on demand.
-  auto file = open_random_access_file(spec);
+  return nullptr;
+}
+
+std::unique_ptr<BrickSource> open_brick_store_file(std::unique_ptr<RandomAccessFile> file,
+                                                   const std::string& spec) {
   if (!has_store_magic(*file)) {
     throw file_error(
         ErrorCode::invalid_argument, spec, 0,
-        "neither an OME-Zarr image (no .zattrs/.zarray/zarr.json below the URL) nor a resoct "
+        "neither an OME-Zarr image (no .zattrs/.zarray/zarr.json below it) nor a resoct "
         "brick store (no store magic)" +
             accepted());
   }
   return std::make_unique<BrickStoreSource>(std::move(file));
+}
+
+/// An http(s) URL: an OME-Zarr image when a URL map is given or the URL has zarr metadata below
+/// it, else a brick store file read by Range requests.
+std::unique_ptr<BrickSource> open_url(const std::string& spec, const BrickLayout& layout,
+                                      const HttpOptions& http) {
+  if (spec.find_first_of("?#") != std::string::npos) {
+    throw invalid_parameter("spec",
+                            "URL '" + spec + "' has a query or fragment, which is unsupported");
+  }
+  std::shared_ptr<const HttpStore> store = open_http_store(spec, http);
+  if (spec.find(',') != std::string::npos) return open_ome_zarr(store, layout);
+  if (auto zarr = open_if_zarr(store, false, layout)) return zarr;
+  // Range requests only: the store's index and metadata are read once, bricks on demand.
+  return open_brick_store_file(open_random_access_file(spec, http), spec);
+}
+
+/// An s3://bucket/key spec: as open_url, in an S3-compatible object store.
+std::unique_ptr<BrickSource> open_s3(const std::string& spec, const BrickLayout& layout,
+                                     const SourceOptions& options) {
+  S3Config config;
+  try {
+    config = resolve_s3_config(options.s3);
+  } catch (const Error& e) {
+    // The configuration comes from elsewhere (options, environment); say which spec needed it.
+    throw Error(e.code(), "'" + spec + "': " + e.what());
+  }
+  std::shared_ptr<const HttpStore> store = open_s3_store(spec, config, options.http);
+  if (auto zarr = open_if_zarr(store, true, layout)) return zarr;
+  return open_brick_store_file(open_s3_object(spec, config, options.http), spec);
 }
 
 }  // namespace
@@ -149,11 +184,19 @@ SourceKind detect_source_kind(std::string_view spec) {
 }
 
 std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayout& layout) {
+  return open_source(spec, layout, SourceOptions{});
+}
+
+std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayout& layout,
+                                         const SourceOptions& options) {
   if (spec.starts_with(kProceduralPrefix)) return make_procedural_source(spec, layout);
-  if (spec.starts_with(kStackPrefix)) return open_stack(spec.substr(kStackPrefix.size()), layout);
+  if (spec.starts_with(kStackPrefix)) {
+    return open_stack(spec.substr(kStackPrefix.size()), layout, options);
+  }
   if (spec.empty()) throw invalid_parameter("spec", "empty source" + accepted());
   const std::string path(spec);
-  if (is_http_url(spec)) return open_url(path, layout);
+  if (is_http_url(spec)) return open_url(path, layout, options.http);
+  if (is_s3_url(spec)) return open_s3(path, layout, options);
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     const int err = errno;

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "resoct/error.hpp"
 #include "resoct/file_io.hpp"
@@ -35,21 +36,12 @@ std::string percent_decode(std::string_view s, const std::string& url) {
   return out;
 }
 
-/// An object on an HTTP server read by Range requests.
+/// An object of an HttpStore read by Range requests.
 class HttpFile final : public RandomAccessFile {
  public:
-  HttpFile(const std::string& url, const HttpOptions& options) : url_(url) {
-    if (url.find_first_of("?#") != std::string::npos) {
-      throw invalid_parameter("url", "'" + url + "' has a query or fragment, which is unsupported");
-    }
-    const std::size_t scheme_end = url.find("://") + 3;
-    const std::size_t slash = url.find_last_of('/');
-    if (slash == std::string::npos || slash < scheme_end || slash + 1 == url.size()) {
-      throw invalid_parameter("url", "'" + url + "' does not name a file on a server");
-    }
-    key_ = percent_decode(std::string_view(url).substr(slash + 1), url);
+  HttpFile(std::shared_ptr<const HttpStore> store, std::string key, std::string name)
+      : url_(std::move(name)), key_(std::move(key)), store_(std::move(store)) {
     check_store_key(key_);
-    store_ = std::make_shared<HttpStore>(UrlMap{url.substr(0, slash), {}}, options);
     const std::optional<std::uint64_t> size = store_->size(key_);
     if (!size) throw file_error(ErrorCode::io, url_, 0, "not found (HTTP 404)");
     size_ = *size;
@@ -72,16 +64,38 @@ class HttpFile final : public RandomAccessFile {
  private:
   std::string url_;
   std::string key_;
-  std::shared_ptr<HttpStore> store_;
+  std::shared_ptr<const HttpStore> store_;
   std::uint64_t size_ = 0;
 };
+
+/// The URL's directory as an HttpStore's base and its last component, decoded, as the key.
+std::unique_ptr<RandomAccessFile> open_http_url(const std::string& url,
+                                                const HttpOptions& options) {
+  if (url.find_first_of("?#") != std::string::npos) {
+    throw invalid_parameter("url", "'" + url + "' has a query or fragment, which is unsupported");
+  }
+  const std::size_t scheme_end = url.find("://") + 3;
+  const std::size_t slash = url.find_last_of('/');
+  if (slash == std::string::npos || slash < scheme_end || slash + 1 == url.size()) {
+    throw invalid_parameter("url", "'" + url + "' does not name a file on a server");
+  }
+  std::string key = percent_decode(std::string_view(url).substr(slash + 1), url);
+  check_store_key(key);
+  auto store = std::make_shared<HttpStore>(UrlMap{url.substr(0, slash), {}}, options);
+  return std::make_unique<HttpFile>(std::move(store), std::move(key), url);
+}
 
 }  // namespace
 
 std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url,
                                                           const HttpOptions& http) {
-  if (is_http_url(path_or_url)) return std::make_unique<HttpFile>(path_or_url, http);
+  if (is_http_url(path_or_url)) return open_http_url(path_or_url, http);
   return std::make_unique<ReadFile>(path_or_url);
+}
+
+std::unique_ptr<RandomAccessFile> open_http_object(std::shared_ptr<const HttpStore> store,
+                                                   std::string key, std::string name) {
+  return std::make_unique<HttpFile>(std::move(store), std::move(key), std::move(name));
 }
 
 std::unique_ptr<RandomAccessFile> open_random_access_file(const std::string& path_or_url) {
