@@ -20,6 +20,29 @@ Error unsupported(std::string_view location, std::string_view key, std::string_v
                std::string(location) + ": key '" + std::string(key) + "': " + std::string(why));
 }
 
+Json parse_zarr_document(std::string_view json, std::string_view location, int version) {
+  Json j;
+  try {
+    j = Json::parse(json.begin(), json.end());
+  } catch (const Json::exception& e) {
+    throw Error(ErrorCode::corrupt, std::string(location) + ": not valid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw corrupt(location, "(root)", "expected a JSON object");
+  const Json& format = required(j, "zarr_format", location);
+  if (!format.is_number_integer()) throw corrupt(location, "zarr_format", "expected an integer");
+  if (format.get<std::int64_t>() != version) {
+    throw Error(ErrorCode::unsupported_version,
+                std::string(location) + ": key 'zarr_format': " + format.dump() +
+                    " is not supported here (expected " + std::to_string(version) + ")");
+  }
+  return j;
+}
+
+const Json& required(const Json& j, const char* key, std::string_view location) {
+  if (!j.contains(key)) throw corrupt(location, key, "missing");
+  return j[key];
+}
+
 std::vector<std::uint64_t> dims(const Json& j, std::string_view location, std::string_view key) {
   if (!j.is_array() || j.empty() || j.size() > 32) {
     throw corrupt(location, key, "expected an array of 1..32 positive integers");

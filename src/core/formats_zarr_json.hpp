@@ -18,6 +18,14 @@ Error corrupt(std::string_view location, std::string_view key, std::string_view 
 /// Error(unsupported): "<location>: key '<key>': <why>".
 Error unsupported(std::string_view location, std::string_view key, std::string_view why);
 
+/// Parses a zarr metadata document (`.zarray`, `zarr.json`): a JSON object whose `zarr_format`
+/// is `version`. Error(corrupt) naming `location` for malformed JSON, another root, a missing or
+/// non-integer `zarr_format`; Error(unsupported_version) naming the key for another version.
+nlohmann::json parse_zarr_document(std::string_view json, std::string_view location, int version);
+
+/// j[key] of an object; Error(corrupt) "<location>: key '<key>': missing" when absent.
+const nlohmann::json& required(const nlohmann::json& j, const char* key, std::string_view location);
+
 /// An array of 1..32 positive integers (shape, chunk shape); Error(corrupt) otherwise.
 std::vector<std::uint64_t> dims(const nlohmann::json& j, std::string_view location,
                                 std::string_view key);

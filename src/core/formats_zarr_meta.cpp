@@ -95,24 +95,8 @@ std::string ZarrArrayMeta::chunk_key(std::span<const std::uint64_t> chunk_index)
 }
 
 ZarrArrayMeta parse_zarr_array_meta(std::string_view json, std::string_view location) {
-  Json j;
-  try {
-    j = Json::parse(json.begin(), json.end());
-  } catch (const Json::exception& e) {
-    throw Error(ErrorCode::corrupt, std::string(location) + ": not valid JSON: " + e.what());
-  }
-  if (!j.is_object()) throw corrupt(location, "(root)", "expected a JSON object");
-  auto need = [&](const char* key) -> const Json& {
-    if (!j.contains(key)) throw corrupt(location, key, "missing");
-    return j[key];
-  };
-  const Json& format = need("zarr_format");
-  if (!format.is_number_integer()) throw corrupt(location, "zarr_format", "expected an integer");
-  if (format.get<std::int64_t>() != 2) {
-    throw Error(ErrorCode::unsupported_version, std::string(location) +
-                                                    ": key 'zarr_format': " + format.dump() +
-                                                    " is not supported (zarr v2 only)");
-  }
+  const Json j = detail::parse_zarr_document(json, location, 2);
+  auto need = [&](const char* key) -> const Json& { return detail::required(j, key, location); };
   ZarrArrayMeta m;
   m.shape = dims(need("shape"), location, "shape");
   m.chunks = dims(need("chunks"), location, "chunks");

@@ -241,24 +241,8 @@ DataType parse_zarr_v3_data_type(std::string_view name, std::string_view locatio
 }
 
 ZarrArrayMeta parse_zarr_v3_array_meta(std::string_view json, std::string_view location) {
-  Json j;
-  try {
-    j = Json::parse(json.begin(), json.end());
-  } catch (const Json::exception& e) {
-    throw Error(ErrorCode::corrupt, std::string(location) + ": not valid JSON: " + e.what());
-  }
-  if (!j.is_object()) throw corrupt(location, "(root)", "expected a JSON object");
-  auto need = [&](const char* key) -> const Json& {
-    if (!j.contains(key)) throw corrupt(location, key, "missing");
-    return j[key];
-  };
-  const Json& format = need("zarr_format");
-  if (!format.is_number_integer()) throw corrupt(location, "zarr_format", "expected an integer");
-  if (format.get<std::int64_t>() != 3) {
-    throw Error(ErrorCode::unsupported_version, std::string(location) +
-                                                    ": key 'zarr_format': " + format.dump() +
-                                                    " is not supported here (zarr v3)");
-  }
+  const Json j = detail::parse_zarr_document(json, location, 3);
+  auto need = [&](const char* key) -> const Json& { return detail::required(j, key, location); };
   const Json& node = need("node_type");
   if (!node.is_string() || node.get<std::string>() != "array") {
     throw corrupt(location, "node_type", "expected \"array\", got " + node.dump());

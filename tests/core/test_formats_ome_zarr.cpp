@@ -19,6 +19,7 @@
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"
 #include "support/tool_process.hpp"
+#include "support/zarr_fixture.hpp"
 
 using namespace resoct;
 
@@ -41,50 +42,6 @@ nlohmann::json find_case(const std::string& name) {
   }
   ADD_FAILURE() << "no case " << name;
   return {};
-}
-
-/// The level-0 voxels of one (t, c) from the raw dump of the numpy array (all axes, C order,
-/// little-endian), as resoct lays them out: x fastest, then y, then z.
-std::vector<std::byte> expected_voxels(const nlohmann::json& c, std::uint64_t t,
-                                       std::uint64_t channel) {
-  const std::string axes = c["axes"];
-  const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
-  const std::string dtype = c["dtype"];
-  const std::size_t vs = std::size_t(dtype[2] - '0');  // "<u2" -> 2, "|i1" -> 1, "<f8" -> 8
-  const std::string raw = test::slurp(data_dir() + "/" + std::string(c["name"]) + ".raw");
-  std::uint64_t total = 1;
-  for (auto s : shape) total *= s;
-  EXPECT_EQ(raw.size(), total * vs);
-  // C-order strides of the full array.
-  std::vector<std::uint64_t> stride(shape.size(), 1);
-  for (std::size_t i = shape.size() - 1; i > 0; --i) stride[i - 1] = stride[i] * shape[i];
-  auto dim = [&](char a) -> std::int64_t {
-    const auto p = axes.find(a);
-    return p == std::string::npos ? -1 : std::int64_t(p);
-  };
-  auto extent = [&](char a) { return dim(a) < 0 ? 1 : shape[std::size_t(dim(a))]; };
-  auto step = [&](char a) { return dim(a) < 0 ? 0 : stride[std::size_t(dim(a))]; };
-  const std::uint64_t base = t * step('t') + channel * step('c');
-  std::vector<std::byte> out;
-  for (std::uint64_t z = 0; z < extent('z'); ++z)
-    for (std::uint64_t y = 0; y < extent('y'); ++y)
-      for (std::uint64_t x = 0; x < extent('x'); ++x) {
-        const std::uint64_t i = base + z * step('z') + y * step('y') + x * step('x');
-        for (std::size_t b = 0; b < vs; ++b) out.push_back(std::byte(raw[i * vs + b]));
-      }
-  return out;
-}
-
-/// An InMemorySource over the expected voxels with the zarr source's description: the
-/// brute-force reference for every brick of every level (coarse levels computed eagerly).
-InMemorySource reference(const nlohmann::json& c, const BrickSource& zarr, std::uint64_t t,
-                         const BrickLayout& layout) {
-  std::vector<std::byte> all;
-  for (std::uint32_t ch = 0; ch < zarr.volume().channels; ++ch) {
-    const auto v = expected_voxels(c, t, ch);
-    all.insert(all.end(), v.begin(), v.end());
-  }
-  return InMemorySource(DenseVolume::from_bytes(zarr.volume(), std::move(all)), layout, 16, "ref");
 }
 
 TEST(OmeZarr, EveryCompressorDtypeChunkingAndAxisSubset) {
@@ -119,13 +76,13 @@ TEST(OmeZarr, EveryCompressorDtypeChunkingAndAxisSubset) {
         EXPECT_EQ(d.spacing[i], p == std::string::npos ? 1.0 : a == 'z' ? 2.0 : 0.5);
       }
       for (std::uint32_t ch = 0; ch < d.channels; ++ch) {
-        const auto want = expected_voxels(c, t, ch);
+        const auto want = test::fixture_voxels(data_dir(), c, t, ch);
         std::vector<std::byte> got(want.size());
         src->read_level_box(0, ch, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, got);
         ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0) << "t " << t << " c " << ch;
       }
       // Every brick with halo and every coarser level against the brute-force reference.
-      test::expect_same_bricks(reference(c, *src, t, layout), *src);
+      test::expect_same_bricks(test::fixture_reference(data_dir(), c, *src, t, layout), *src);
       ++checked;
     }
   }
@@ -147,7 +104,7 @@ TEST(OmeZarr, StoredLevelsServeTheHierarchyAndMissingOnesAreBuilt) {
     EXPECT_FALSE(src->stored_level(3));
     // The file's levels were written with resoct's rule, so stored and computed levels alike
     // equal whole-level downsampling of level 0.
-    test::expect_same_bricks(reference(c, *src, 0, layout), *src);
+    test::expect_same_bricks(test::fixture_reference(data_dir(), c, *src, 0, layout), *src);
     EXPECT_GT(src->chunk_cache_stats().hits, 0u);
   }
 }
@@ -161,7 +118,7 @@ TEST(OmeZarr, MissingChunksReadAsFillValue) {
     EXPECT_FALSE(std::filesystem::exists(dir + "/0/2/3/3"));
     EXPECT_TRUE(std::filesystem::exists(dir + "/0/0/0/0"));
     const auto src = open_ome_zarr(dir, BrickLayout{glm::uvec3(4), 1});
-    const auto want = expected_voxels(c, 0, 0);
+    const auto want = test::fixture_voxels(data_dir(), c, 0, 0);
     std::vector<std::byte> got(want.size());
     src->read_level_box(0, 0, Box3{glm::i64vec3(0), glm::i64vec3(src->volume().extent)}, got);
     ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0);
@@ -180,7 +137,7 @@ TEST(OmeZarr, MissingChunksReadAsFillValue) {
 std::vector<double> expected_values(const nlohmann::json& c, std::uint64_t channel) {
   const std::string dtype = std::string(c["dtype"]).substr(1);
   const std::size_t vs = std::size_t(dtype[1] - '0');
-  const auto bytes = expected_voxels(c, 0, channel);  // raw values, little-endian, vs each
+  const auto bytes = test::fixture_values(data_dir(), c, 0, channel);  // little-endian, vs each
   std::vector<double> out;
   for (std::size_t i = 0; i + vs <= bytes.size(); i += vs) {
     auto get = [&](auto v) {
@@ -237,7 +194,9 @@ TEST(OmeZarr, SignedAndWideDtypesKeepTheirValuesThroughTheMapping) {
           v = double(f);
         }
         const double w = d.type == VoxelType::f32 ? double(float(want[i])) : want[i];
-        if (!(std::isnan(w) && std::isnan(v))) ASSERT_EQ(v, w) << "c " << ch << " voxel " << i;
+        if (!(std::isnan(w) && std::isnan(v))) {
+          ASSERT_EQ(v, w) << "c " << ch << " voxel " << i;
+        }
       }
       if (name == "typed_fill_i2") {
         EXPECT_EQ(want.back(), -1024.0);  // the last voxel lies in an unwritten chunk
@@ -327,7 +286,7 @@ TEST(OmeZarr, DecodedChunkCacheServesEveryBrickCutFromAChunk) {
 TEST(OmeZarr, RangesFromDataWithoutOmero) {
   const auto c = find_case("zstd_lef4_small_zyx");
   const auto src = open_ome_zarr(data_dir() + "/zstd_lef4_small_zyx.zarr");
-  const auto v = expected_voxels(c, 0, 0);
+  const auto v = test::fixture_voxels(data_dir(), c, 0, 0);
   float lo = 1e30f, hi = -1e30f;
   for (std::size_t i = 0; i < v.size(); i += 4) {
     float f;

@@ -24,6 +24,7 @@
 #include "support/expect_error.hpp"
 #include "support/generated_data.hpp"
 #include "support/tool_process.hpp"
+#include "support/zarr_fixture.hpp"
 
 using namespace resoct;
 
@@ -39,71 +40,6 @@ const std::string& data_dir() {
 const nlohmann::json& manifest() {
   static const nlohmann::json m = nlohmann::json::parse(test::slurp(data_dir() + "/manifest.json"));
   return m;
-}
-
-/// The voxels of one (t, c) from the raw dump (all axes, C order, little-endian) in resoct's
-/// layout: x fastest, then y, then z.
-std::vector<std::byte> expected_voxels(const nlohmann::json& c, std::uint64_t t,
-                                       std::uint64_t channel) {
-  const std::string axes = c["axes"];
-  const auto shape = c["shape"].get<std::vector<std::uint64_t>>();
-  const std::string dtype = c["dtype"];
-  const std::size_t vs = std::size_t(dtype[2] - '0');  // "<u2" -> 2, "|i1" -> 1, "<f8" -> 8
-  const std::string raw = test::slurp(data_dir() + "/" + std::string(c["name"]) + ".raw");
-  std::vector<std::uint64_t> stride(shape.size(), 1);
-  for (std::size_t i = shape.size() - 1; i > 0; --i) stride[i - 1] = stride[i] * shape[i];
-  auto dim = [&](char a) -> std::int64_t {
-    const auto p = axes.find(a);
-    return p == std::string::npos ? -1 : std::int64_t(p);
-  };
-  auto extent = [&](char a) { return dim(a) < 0 ? 1 : shape[std::size_t(dim(a))]; };
-  auto step = [&](char a) { return dim(a) < 0 ? 0 : stride[std::size_t(dim(a))]; };
-  const std::uint64_t base = t * step('t') + channel * step('c');
-  std::vector<std::byte> out;
-  for (std::uint64_t z = 0; z < extent('z'); ++z)
-    for (std::uint64_t y = 0; y < extent('y'); ++y)
-      for (std::uint64_t x = 0; x < extent('x'); ++x) {
-        const std::uint64_t i = base + z * step('z') + y * step('y') + x * step('x');
-        for (std::size_t b = 0; b < vs; ++b) out.push_back(std::byte(raw[i * vs + b]));
-      }
-  return out;
-}
-
-/// expected_voxels as resoct keeps them (voxel_type.hpp's documented mapping, written out here):
-/// int8 / int16 plus 128 / 32768 as uint8 / uint16, int32, uint32 and float64 as float32.
-std::vector<std::byte> expected_stored(const nlohmann::json& c, std::uint64_t t,
-                                       std::uint64_t channel) {
-  const std::string dtype = std::string(c["dtype"]).substr(1);
-  std::vector<std::byte> raw = expected_voxels(c, t, channel);
-  if (dtype == "u1" || dtype == "u2" || dtype == "f4") return raw;
-  const std::size_t vs = std::size_t(dtype[1] - '0');
-  std::vector<std::byte> out;
-  for (std::size_t i = 0; i + vs <= raw.size(); i += vs) {
-    auto put = [&](auto v) {
-      const auto* p = reinterpret_cast<const std::byte*>(&v);
-      out.insert(out.end(), p, p + sizeof v);
-    };
-    auto get = [&](auto v) {
-      std::memcpy(&v, raw.data() + i, sizeof v);
-      return v;
-    };
-    if (dtype == "i1") put(std::uint8_t(int(get(std::int8_t())) + 128));
-    if (dtype == "i2") put(std::uint16_t(int(get(std::int16_t())) + 32768));
-    if (dtype == "i4") put(float(get(std::int32_t())));
-    if (dtype == "u4") put(float(get(std::uint32_t())));
-    if (dtype == "f8") put(float(get(double())));
-  }
-  return out;
-}
-
-InMemorySource reference(const nlohmann::json& c, const BrickSource& zarr, std::uint64_t t,
-                         const BrickLayout& layout) {
-  std::vector<std::byte> all;
-  for (std::uint32_t ch = 0; ch < zarr.volume().channels; ++ch) {
-    const auto v = expected_stored(c, t, ch);
-    all.insert(all.end(), v.begin(), v.end());
-  }
-  return InMemorySource(DenseVolume::from_bytes(zarr.volume(), std::move(all)), layout, 16, "ref");
 }
 
 std::string bad(const std::string& name) {
@@ -144,14 +80,15 @@ TEST(OmeZarrV3, EveryCodecDtypeAndShardLayoutMatchesNumpy) {
       EXPECT_EQ(src->multiscales().version, "0.5");
       const VolumeDesc& d = src->volume();
       for (std::uint32_t ch = 0; ch < d.channels; ++ch) {
-        const auto want = expected_stored(c, t, ch);
+        const auto want = test::fixture_voxels(data_dir(), c, t, ch);
         std::vector<std::byte> got(want.size());
         src->read_level_box(0, ch, Box3{glm::i64vec3(0), glm::i64vec3(d.extent)}, got);
         ASSERT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0) << "t " << t << " c " << ch;
       }
       // Stored coarser levels are subsampled, not resoct's mean: the 0.4/0.5 pair test
       // compares those.
-      if (c["levels"] == 1) test::expect_same_bricks(reference(c, *src, t, layout), *src);
+      if (c["levels"] == 1)
+        test::expect_same_bricks(test::fixture_reference(data_dir(), c, *src, t, layout), *src);
     }
   }
 }
