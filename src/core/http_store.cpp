@@ -167,6 +167,32 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
   return len;
 }
 
+/// "bytes FIRST-LAST/TOTAL" of a 206 answer, or nullopt (TOTAL: nullopt when '*').
+struct ContentRange {
+  std::uint64_t first = 0, last = 0;
+  std::optional<std::uint64_t> total;
+};
+std::optional<ContentRange> parse_content_range(std::string_view cr) {
+  if (!cr.starts_with("bytes ")) return std::nullopt;
+  cr.remove_prefix(6);
+  const std::size_t dash = cr.find('-'), slash = cr.find('/');
+  if (dash == std::string_view::npos || slash == std::string_view::npos || dash > slash) {
+    return std::nullopt;
+  }
+  const auto first = parse_u64(cr.substr(0, dash));
+  const auto last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
+  if (!first || !last) return std::nullopt;
+  return ContentRange{*first, *last, parse_u64(cr.substr(slash + 1))};
+}
+
+/// Whether a 206 answer to "bytes=-want" is the object's tail. Some servers misread a suffix
+/// range (s3rver parses "bytes=-132" as bytes 0-132): their answer is a refusal, not data.
+bool answers_suffix(const Attempt& a) {
+  const auto cr = parse_content_range(a.content_range);
+  return cr && cr->total && cr->last + 1 == *cr->total &&
+         cr->first == *cr->total - std::min(a.want, *cr->total);
+}
+
 std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
   auto& a = *static_cast<Attempt*>(user);
   const std::size_t len = size * n;
@@ -188,6 +214,10 @@ std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
     return len;
   }
   if (a.status == 206) {
+    if (a.suffix && at == 0 && !answers_suffix(a)) {
+      a.suffix_refused = true;  // the caller falls back to the size and a first-last range
+      return 0;
+    }
     if (a.received > a.want) {
       a.bad_answer = "206 answer longer than the " + std::to_string(a.want) + " bytes requested";
       return 0;
@@ -564,24 +594,6 @@ struct HttpStore::Impl {
     if (a.ranged && a.suffix) return check_suffix(a, code, why);
     if (a.ranged) return check_range(a, code, why);
     return Outcome::done;
-  }
-
-  /// "bytes FIRST-LAST/TOTAL" of a 206 answer, or nullopt (TOTAL: nullopt when '*').
-  struct ContentRange {
-    std::uint64_t first = 0, last = 0;
-    std::optional<std::uint64_t> total;
-  };
-  static std::optional<ContentRange> parse_content_range(std::string_view cr) {
-    if (!cr.starts_with("bytes ")) return std::nullopt;
-    cr.remove_prefix(6);
-    const std::size_t dash = cr.find('-'), slash = cr.find('/');
-    if (dash == std::string_view::npos || slash == std::string_view::npos || dash > slash) {
-      return std::nullopt;
-    }
-    const auto first = parse_u64(cr.substr(0, dash));
-    const auto last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
-    if (!first || !last) return std::nullopt;
-    return ContentRange{*first, *last, parse_u64(cr.substr(slash + 1))};
   }
 
   static Outcome check_suffix(Attempt& a, ErrorCode& code, std::string& why) {

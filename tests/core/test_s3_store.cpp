@@ -34,20 +34,37 @@ const std::string& zarr_dir() {
   return dir;
 }
 
+const std::string& zarr_v3_dir() {
+  static const std::string dir =
+      test::python_generated_dir(RESOCT_BINARY_DIR "/test-data", "ome-zarr-v3",
+                                 RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr_v3.py");
+  return dir;
+}
+
+/// OME-Zarr 0.5 images in the bucket: sharded (index at the end, so read by suffix range or
+/// its fallback) and an int16 one with missing shards.
+const char* const kV3Images[] = {"zstd_u2_shard-end.zarr", "typed_fill_i2.zarr"};
+
 const BrickLayout kLayout{glm::uvec3(8), 1};
 
-/// Bucket "data": cells.rbs (a brick store), images/pyramid_u2.zarr and images/fill_u1.zarr.
+/// Bucket "data": cells.rbs (a brick store), images/pyramid_u2.zarr and images/fill_u1.zarr
+/// (OME-Zarr 0.4), images/<kV3Images> (OME-Zarr 0.5).
 /// Bucket "empty": nothing.
 class S3Store : public ::testing::Test {
  protected:
   void SetUp() override {
     RESOCT_SKIP_WITHOUT_S3_SERVER();
     ASSERT_FALSE(zarr_dir().empty());
+    ASSERT_FALSE(zarr_v3_dir().empty());
     auto src = make_procedural_source("procedural:tubes:48x40x24", kLayout);
     write_brick_store(*src, dir_.file("cells.rbs"));
     std::filesystem::create_directory(dir_.file("images"));
     for (const char* name : {"pyramid_u2.zarr", "fill_u1.zarr"}) {
       std::filesystem::create_directory_symlink(zarr_dir() + "/" + name,
+                                                dir_.file("images/" + std::string(name)));
+    }
+    for (const char* name : kV3Images) {
+      std::filesystem::create_directory_symlink(zarr_v3_dir() + "/" + name,
                                                 dir_.file("images/" + std::string(name)));
     }
     server_ = std::make_unique<S3TestServer>(
@@ -96,6 +113,16 @@ TEST_F(S3Store, SignedOmeZarrReadsEqualTheLocalImage) {
     const auto local = open_ome_zarr(zarr_dir() + "/" + name + ".zarr", kLayout);
     const auto remote =
         open_source("s3://data/images/" + std::string(name) + ".zarr/", kLayout, options());
+    test::expect_same_bricks(*local, *remote);
+  }
+}
+
+TEST_F(S3Store, SignedShardedOmeZarr05ReadsEqualTheLocalImage) {
+  for (const char* name : kV3Images) {
+    SCOPED_TRACE(name);
+    const auto local = open_ome_zarr(zarr_v3_dir() + "/" + name, kLayout);
+    const auto remote = open_source("s3://data/images/" + std::string(name), kLayout, options());
+    EXPECT_EQ(remote->volume(), local->volume());
     test::expect_same_bricks(*local, *remote);
   }
 }
