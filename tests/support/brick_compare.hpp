@@ -5,7 +5,8 @@
 
 namespace resoct::test {
 
-/// Asserts (gtest) that both sources have the same hierarchy and identical brick bytes.
+/// Asserts (gtest) that both sources have the same brick layout, the same VolumeDesc but for
+/// `origin` (brick stores do not persist it), and identical brick bytes.
 void expect_same_bricks(const BrickSource& a, const BrickSource& b);
 
 }  // namespace resoct::test
