@@ -83,6 +83,7 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
   // "value_offset" say how the cache keeps it, "exact" whether that loses nothing.
   j["volume"] = {{"extent", vec(v.extent)},
                  {"spacing", vec(v.spacing)},
+                 {"origin", vec(v.origin)},
                  {"physical_size", vec(physical_size(v))},
                  {"channels", v.channels},
                  {"type", std::string(to_string(v.file_type()))},
@@ -149,6 +150,8 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
   std::printf("  volume   %s voxels, %u channel(s), %s, spacing %g x %g x %g (size %g x %g x %g)\n",
               xyz(v.extent).c_str(), v.channels, describe_mapping(v.file_type()).c_str(),
               v.spacing.x, v.spacing.y, v.spacing.z, phys.x, phys.y, phys.z);
+  // Where the volume sits (the low corner of voxel 0, docs/formats.md "Physical placement").
+  std::printf("  origin   %g, %g, %g\n", v.origin.x, v.origin.y, v.origin.z);
   std::printf("  ranges   %s\n", ranges_text(v).c_str());
   std::printf("  bricks   %s core, halo %u, %s padded (%s each)\n", xyz(lay.brick_size).c_str(),
               lay.halo, xyz(lay.padded_size()).c_str(),

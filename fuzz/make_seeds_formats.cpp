@@ -142,6 +142,77 @@ void nifti_seeds(std::vector<Seed>& out) {
   out.push_back({"nifti_header", "seed-u16-2d.nii", nifti(d)});
 }
 
+// A NIfTI-2 header (540 bytes) plus the 4-byte extension flag, in either byte order.
+struct Nifti2Fields {
+  bool big = false;
+  const char* magic = "n+2\0\r\n\032\n";
+  std::int64_t dim[8] = {3, 8, 8, 4, 1, 1, 1, 1};
+  std::int16_t datatype = 2, bitpix = 8;
+  double pixdim[8] = {1, 1, 1, 2.5, 1, 1, 1, 1};
+  std::int64_t vox_offset = 544;
+  double slope = 0, inter = 0;
+  std::int32_t qform = 0, sform = 0;
+  double quatern[3] = {}, qoffset[3] = {};
+  double srow[12] = {};
+};
+
+std::vector<std::byte> nifti2(const Nifti2Fields& f) {
+  std::vector<std::byte> b(544, std::byte{0});
+  auto put = [&](std::size_t at, const void* v, std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      b[at + (f.big ? n - 1 - i : i)] = static_cast<const std::byte*>(v)[i];
+    }
+  };
+  const std::int32_t sizeof_hdr = 540;
+  put(0, &sizeof_hdr, 4);
+  std::memcpy(b.data() + 4, f.magic, 8);
+  put(12, &f.datatype, 2);
+  put(14, &f.bitpix, 2);
+  for (std::size_t i = 0; i < 8; ++i) put(16 + 8 * i, &f.dim[i], 8);
+  for (std::size_t i = 0; i < 8; ++i) put(104 + 8 * i, &f.pixdim[i], 8);
+  put(168, &f.vox_offset, 8);
+  put(176, &f.slope, 8);
+  put(184, &f.inter, 8);
+  put(344, &f.qform, 4);
+  put(348, &f.sform, 4);
+  for (std::size_t i = 0; i < 3; ++i) put(352 + 8 * i, &f.quatern[i], 8);
+  for (std::size_t i = 0; i < 3; ++i) put(376 + 8 * i, &f.qoffset[i], 8);
+  for (std::size_t i = 0; i < 12; ++i) put(400 + 8 * i, &f.srow[i], 8);
+  return b;
+}
+
+void nifti2_seeds(std::vector<Seed>& out) {
+  Nifti2Fields a;
+  out.push_back({"nifti_header", "seed-nifti2-u8-le.nii", nifti2(a)});
+  Nifti2Fields b;
+  b.big = true;
+  b.dim[0] = 5;
+  b.dim[4] = 3;
+  b.dim[5] = 2;
+  b.datatype = 4;
+  b.bitpix = 16;
+  b.sform = 1;
+  const double srow[12] = {0, -0.5, 0, 10, 0.5, 0, 0, -5, 0, 0, 2, 0};
+  std::memcpy(b.srow, srow, sizeof srow);
+  out.push_back({"nifti_header", "seed-nifti2-i16-be-5d-sform.nii", nifti2(b)});
+  Nifti2Fields c;
+  c.magic = "ni2\0\r\n\032\n";
+  c.datatype = 64;
+  c.bitpix = 64;
+  c.vox_offset = 0;
+  c.qform = 1;
+  c.pixdim[0] = -1;
+  c.quatern[2] = 1;
+  c.qoffset[0] = 4;
+  out.push_back({"nifti_header", "seed-nifti2-pair-f64-qform.hdr", nifti2(c)});
+  NiftiFields d;  // Analyze 7.5: no magic, data at offset 0 of the .img
+  d.vox_offset = 0;
+  auto analyze = nifti(d);
+  std::memset(analyze.data() + 344, 0, 4);
+  analyze.resize(348);
+  out.push_back({"nifti_header", "seed-analyze-u8.hdr", analyze});
+}
+
 void nrrd_seeds(std::vector<Seed>& out) {
   const char* headers[] = {
       "NRRD0004\n# a comment\ntype: uint8\ndimension: 3\nsizes: 8 8 4\nencoding: raw\n"
@@ -345,6 +416,15 @@ void nifti_file_seeds(std::vector<Seed>& out) {
     fc.insert(fc.end(), raw, raw + 4);
   }
   out.push_back({"nifti_file", "seed-f32-nan.nii", fc});
+  // NIfTI-2, 4-D (3 timepoints) with an sform that flips x and swaps y and z: the reordering path.
+  Nifti2Fields d;
+  d.dim[0] = 4, d.dim[1] = 4, d.dim[2] = 3, d.dim[3] = 2, d.dim[4] = 3;
+  d.sform = 2;
+  const double srow[12] = {-1, 0, 0, 3, 0, 0, 2, 0, 0, 1.5, 0, 0};
+  std::memcpy(d.srow, srow, sizeof srow);
+  std::vector<std::byte> fd = nifti2(d);
+  for (int i = 0; i < 72; ++i) fd.push_back(std::byte(i * 3));
+  out.push_back({"nifti_file", "seed-nifti2-4d-sform-permuted.nii", fd});
 }
 
 void nrrd_file_seeds(std::vector<Seed>& out) {
@@ -435,6 +515,7 @@ void format_seeds(const fs::path& scratch, std::vector<Seed>& out) {
   zarr_chunk_seeds(out);
   ome_seeds(out);
   nifti_seeds(out);
+  nifti2_seeds(out);
   nrrd_seeds(out);
   ome_zarr_seeds(out);
   png_seeds(scratch / "png", out);

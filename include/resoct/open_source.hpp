@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "resoct/brick_source.hpp"
+#include "resoct/formats/nifti.hpp"
 #include "resoct/http_store.hpp"
 #include "resoct/s3_store.hpp"
 
@@ -15,7 +16,8 @@ namespace resoct {
 /// The accepted forms, for help texts and error messages.
 inline constexpr std::string_view kSourceSpecForms =
     "procedural:NAME[:WxHxD[:CHANNELS]], a resoct brick store (.rbs), an OME-Zarr directory, "
-    "a NIfTI-1 file (.nii, .nii.gz), an NRRD file (.nrrd, .nhdr), a TIFF file or a directory of "
+    "a NIfTI-1/2 file (.nii, .nii.gz) or NIfTI / Analyze pair (.hdr + .img), an NRRD file (.nrrd, "
+    ".nhdr), a TIFF file or a directory of "
     "TIFF files (.tif, .tiff), stack:SPEC+SPEC+... (sources on one grid as channels), an "
     "http(s):// URL of a brick store or an OME-Zarr image (URL[,PREFIX=URL]..., docs/http.md), or "
     "an s3://bucket/key of one (S3-compatible object stores, docs/http.md)";
@@ -44,7 +46,8 @@ SourceKind detect_source_kind(std::string_view spec);
 /// How remote sources are reached (network behaviour, S3 endpoint and credentials).
 struct SourceOptions {
   HttpOptions http;
-  S3Options s3;  ///< empty fields are taken from the environment (resolve_s3_config)
+  S3Options s3;        ///< empty fields are taken from the environment (resolve_s3_config)
+  NiftiOptions nifti;  ///< for NIfTI / Analyze files (the timepoint of a 4-D image)
 };
 
 /// Opens the source `spec` names:

@@ -32,6 +32,7 @@ struct RawVolumeOptions {
   VoxelType type = VoxelType::u8;  ///< u8, u16 or f32
   Endian endian = Endian::little;  ///< byte order of u16 / f32 voxels (ignored for u8)
   glm::dvec3 spacing{1.0};         ///< physical voxel size, each a positive finite number
+  glm::dvec3 origin{0.0};          ///< VolumeDesc::origin: low corner of voxel 0, each finite
   std::uint32_t channels = 1;      ///< 1..kMaxChannels
   std::uint64_t offset = 0;        ///< header bytes skipped before the first voxel
   std::vector<ValueRange> ranges;  ///< one per channel, or empty for default_range(type)

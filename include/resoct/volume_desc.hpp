@@ -1,7 +1,7 @@
 #pragma once
 /// \file
-/// What a volume is, independent of how it is bricked: extent, spacing, channels, voxel type
-/// (and the file's own value type when it is kept mapped).
+/// What a volume is, independent of how it is bricked: extent, spacing, physical origin, channels,
+/// voxel type (and the file's own value type when it is kept mapped).
 
 #include <cstdint>
 #include <optional>
@@ -18,8 +18,15 @@ namespace resoct {
 inline constexpr std::uint32_t kMaxChannels = 256;
 
 struct VolumeDesc {
-  glm::u64vec3 extent{1};          ///< level-0 voxels per axis, each >= 1
-  glm::dvec3 spacing{1.0};         ///< physical size of one level-0 voxel per axis, each > 0
+  glm::u64vec3 extent{1};   ///< level-0 voxels per axis, each >= 1
+  glm::dvec3 spacing{1.0};  ///< physical size of one level-0 voxel per axis, each > 0
+  /// Physical position of the low corner of voxel (0, 0, 0), in the units of `spacing` and in
+  /// the file's world frame (NIfTI RAS+, NRRD converted to RAS+, OME-Zarr's own axes): voxel
+  /// (i, j, k) covers origin + (i, j, k) * spacing .. origin + (i + 1, j + 1, k + 1) * spacing.
+  /// The formats place voxel centres, so a reader sets origin = centre of voxel 0 - spacing / 2
+  /// (docs/formats.md, "Physical placement"). Each component finite; not persisted in brick
+  /// stores (they read back 0).
+  glm::dvec3 origin{0.0};
   std::uint32_t channels = 1;      ///< 1..kMaxChannels
   VoxelType type = VoxelType::u8;  ///< stored natively
   std::vector<ValueRange> ranges;  ///< one per channel; empty means default_range(type) for all
@@ -43,7 +50,8 @@ struct VolumeDesc {
 
   /// Throws Error naming the offending field (`what` prefixes the message, e.g. a file name)
   /// when an extent is zero, the voxel or byte count overflows 64 bits, a spacing is not a
-  /// positive finite number, the channel count is 0 or above kMaxChannels, or a range is empty.
+  /// positive finite number, an origin component is not finite, the channel count is 0 or above
+  /// kMaxChannels, or a range is empty.
   void validate(const std::string& what = "volume") const;
 
   friend bool operator==(const VolumeDesc&, const VolumeDesc&) = default;

@@ -60,7 +60,7 @@ struct Section {
 
 std::vector<std::byte> encode_header(const StoreHeader& h) {
   const std::uint32_t channels = h.volume.channels;
-  std::vector<std::byte> b(header_size_for(channels));
+  std::vector<std::byte> b(header_size_for(channels, h.flags));
   for (std::size_t i = 0; i < kStoreMagic.size(); ++i) b[i] = std::byte(kStoreMagic[i]);
   put_u32(b, hdr::version, kStoreVersion);
   put_u32(b, hdr::header_size, std::uint32_t(b.size()));
@@ -92,6 +92,10 @@ std::vector<std::byte> encode_header(const StoreHeader& h) {
     const ValueRange r = h.volume.range(c);
     put_f64(b, hdr::ranges + 16u * c, r.lo);
     put_f64(b, hdr::ranges + 16u * c + 8u, r.hi);
+  }
+  if ((h.flags & kFlagOrigin) != 0) {
+    for (int i = 0; i < 3; ++i)
+      put_f64(b, hdr::ranges + 16u * channels + 8u * i, h.volume.origin[i]);
   }
   const std::uint64_t crc_at = b.size() - 4;
   put_u32(b, crc_at, crc32(std::span<const std::byte>(b).first(crc_at)));
@@ -161,7 +165,7 @@ StoreHeader decode_header(const RandomAccessFile& file) {
                "channel count " + std::to_string(channels) + " outside 1.." +
                    std::to_string(kMaxChannels));
   }
-  if (hs != header_size_for(channels)) {
+  if (hs != header_size_for(channels, h.flags)) {
     throw fail(ErrorCode::corrupt, hdr::header_size,
                "header size " + std::to_string(hs) + " does not match " + std::to_string(channels) +
                    " channels");
@@ -239,6 +243,15 @@ StoreHeader decode_header(const RandomAccessFile& file) {
     h.volume.ranges.push_back(r);
   }
   if ((h.flags & kFlagDefaultRanges) != 0) h.volume.ranges.clear();
+  if ((h.flags & kFlagOrigin) != 0) {
+    for (int i = 0; i < 3; ++i) {
+      const std::uint64_t at = hdr::ranges + 16u * channels + 8u * i;
+      h.volume.origin[i] = get_f64(b, at);
+      if (!std::isfinite(h.volume.origin[i])) {
+        throw fail(ErrorCode::corrupt, at, std::string("origin.") + "xyz"[i] + " is not finite");
+      }
+    }
+  }
 
   // The hierarchy rejects volumes whose brick coordinates do not fit a brick key.
   std::uint64_t bpc = 0;

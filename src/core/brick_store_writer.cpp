@@ -262,12 +262,13 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
   hdr.volume = vol;
   hdr.layout = h.layout();
   hdr.flags = vol.ranges.empty() ? detail::kFlagDefaultRanges : 0u;
+  if (vol.origin != glm::dvec3(0.0)) hdr.flags |= detail::kFlagOrigin;
   hdr.codec = options.codec;
   hdr.codec_level = options.level;
   hdr.metadata_block = options.metadata_block;
   hdr.level_count = h.level_count();
   hdr.bricks_per_channel = h.bricks_per_channel();
-  const std::uint64_t header_size = detail::header_size_for(vol.channels);
+  const std::uint64_t header_size = detail::header_size_for(vol.channels, hdr.flags);
 
   AtomicFileWriter out(path);
   out.append(std::vector<std::byte>(header_size));  // rewritten once the offsets are known

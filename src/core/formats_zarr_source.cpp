@@ -386,7 +386,14 @@ std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> st
   if (data_type_of(img->type) != img->data_type) desc.data_type = img->data_type;
   desc.channels = d0.c >= 0 ? std::uint32_t(d0.meta.shape[std::size_t(d0.c)]) : 1u;
   for (int a = 0; a < 3; ++a) {
-    if (d0.spatial[a] >= 0) desc.spacing[a] = img->ms.datasets[0].scale[std::size_t(d0.spatial[a])];
+    if (d0.spatial[a] >= 0) {
+      // The finest dataset places the volume. NGFF 0.4 / 0.5 do not say whether a translation
+      // places voxel 0's centre or its corner; it is read as the corner, so that an image
+      // without one starts at 0 (docs/formats.md, "Physical placement").
+      const auto axis = std::size_t(d0.spatial[a]);
+      desc.spacing[a] = img->ms.datasets[0].scale[axis];
+      desc.origin[a] = img->ms.datasets[0].translation[axis];
+    }
   }
   PyramidSourceOptions po = options.pyramid;
   if (img->ms.channels.size() == desc.channels) {

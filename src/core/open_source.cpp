@@ -73,7 +73,10 @@ SourceKind kind_of_directory(const std::string& path) {
 SourceKind kind_of_file(const std::string& path) {
   if (has_store_magic(ReadFile(path))) return SourceKind::brick_store;
   const std::string name = lower(std::filesystem::path(path).filename().string());
-  if (ends_with(name, ".nii") || ends_with(name, ".nii.gz")) return SourceKind::nifti;
+  // NIfTI-1/2 single files, and either file of a NIfTI / Analyze 7.5 pair (.hdr + .img).
+  for (const char* ext : {".nii", ".hdr", ".img"}) {
+    if (ends_with(name, ext) || ends_with(name, std::string(ext) + ".gz")) return SourceKind::nifti;
+  }
   if (ends_with(name, ".nrrd") || ends_with(name, ".nhdr")) return SourceKind::nrrd;
   if (ends_with(name, ".tif") || ends_with(name, ".tiff")) return SourceKind::tiff;
   return SourceKind::unknown;
@@ -221,7 +224,7 @@ std::unique_ptr<BrickSource> open_source(std::string_view spec, const BrickLayou
   }
   switch (kind_of_file(path)) {
     case SourceKind::brick_store: return std::make_unique<BrickStoreSource>(path);
-    case SourceKind::nifti: return open_nifti(path, layout);
+    case SourceKind::nifti: return open_nifti(path, layout, options.nifti);
     case SourceKind::nrrd: return open_nrrd(path, layout);
     case SourceKind::tiff: return open_tiff_stack(path, layout);
     default:

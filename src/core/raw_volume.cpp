@@ -79,6 +79,7 @@ DenseVolume open_raw_volume(const std::string& path, const RawVolumeOptions& opt
   VolumeDesc desc;
   desc.extent = options.extent;
   desc.spacing = options.spacing;
+  desc.origin = options.origin;
   desc.channels = options.channels;
   desc.type = options.type;
   desc.ranges = options.ranges;

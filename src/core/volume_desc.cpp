@@ -46,6 +46,11 @@ void VolumeDesc::validate(const std::string& what) const {
                                                    "': must be a positive finite number, got " +
                                                    std::to_string(spacing[i]));
     }
+    if (!std::isfinite(origin[i])) {
+      throw Error(ErrorCode::invalid_argument, what + ": parameter 'origin." + axis[i] +
+                                                   "': must be a finite number, got " +
+                                                   std::to_string(origin[i]));
+    }
   }
   if (channels == 0 || channels > kMaxChannels) {
     throw Error(ErrorCode::invalid_argument, what + ": parameter 'channels': must be 1.." +

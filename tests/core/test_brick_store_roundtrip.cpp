@@ -227,6 +227,30 @@ TEST(BrickStore, AllZeroVolumeHasNoPayloadBytes) {
   EXPECT_EQ(r.occupancy, 1u);
 }
 
+// A placed volume (a NIfTI's sform, an OME translation) keeps its origin through a store; an
+// unplaced one writes no origin, so its header is the size it always was.
+TEST(BrickStore, OriginIsKeptAndOnlyWrittenWhenNotZero) {
+  VolumeDesc v;
+  v.extent = {12, 10, 9};
+  v.type = VoxelType::u8;
+  TempDir dir;
+  for (const glm::dvec3 origin : {glm::dvec3(0.0), glm::dvec3(-90.5, -125.5, 71.25)}) {
+    v.origin = origin;
+    const FunctionSource src(
+        v, BrickLayout{glm::uvec3(8), 1},
+        [](std::uint32_t, const glm::u64vec3& p) { return double(p.x + p.z); });
+    const std::string path = dir.file("placed.rbs");
+    write_brick_store(src, path, StoreWriteOptions{Codec::lz4});
+    const BrickStoreSource store(path);
+    EXPECT_EQ(store.volume(), v);
+    const std::vector<std::uint8_t> bytes = test::read_bytes(path);
+    const std::uint64_t header_size = test::get_le(bytes, test::layout::header_size, 4);
+    EXPECT_EQ(header_size, origin == glm::dvec3(0.0) ? 188u + 16u : 188u + 16u + 24u);
+    EXPECT_EQ(test::get_le(bytes, test::layout::flags, 4) & 2u,
+              origin == glm::dvec3(0.0) ? 0u : 2u);
+  }
+}
+
 TEST(BrickStore, FileDoesNotDependOnThreadCountAndProgressCountsEveryBrick) {
   const FunctionSource src =
       make_source(VoxelType::u16, 2, {40, 33, 17}, BrickLayout{glm::uvec3(8), 1}, true);

@@ -224,6 +224,8 @@ TEST(OmeZarr, OmeroWindowsAreChannelRanges) {
   EXPECT_EQ(src->multiscales().channels[0].label, "DAPI");
   EXPECT_EQ(src->multiscales().channels[1].color, "00FF00");
   EXPECT_EQ(src->array(0).compressor, ZarrCompressor::zlib);
+  // The finest dataset's translation (c, z, y, x) places the corner of voxel 0 (x, y, z).
+  EXPECT_EQ(src->volume().origin, glm::dvec3(3.0, -2.0, 1.5));
 }
 
 /// Any ByteStore works (the HTTP store included); this one counts chunk reads.

@@ -76,7 +76,7 @@ def write_raw(path, arr):
 
 
 def write_case(outdir, name, names, shape, chunks, dtype, comp, sep, levels=1, fill=0,
-               region=None, omero=None, seed=0):
+               region=None, omero=None, seed=0, translation=None):
     """levels > 1 writes coarser datasets downsampled 2x along every spatial axis with resoct's
     rule (mean of the existing children, integers round half up, NaN ignored)."""
     path = os.path.join(outdir, name + ".zarr")
@@ -103,7 +103,7 @@ def write_case(outdir, name, names, shape, chunks, dtype, comp, sep, levels=1, f
             z[...] = level
         datasets.append({"path": str(lv), "coordinateTransformations": [
             {"type": "scale", "scale": list(scale)},
-            {"type": "translation", "translation": [0.0] * len(names)}]})
+            {"type": "translation", "translation": translation or [0.0] * len(names)}]})
         if lv + 1 < levels:
             level = downsample(level, names)
             scale = [s * 2 if a in "zyx" else s for s, a in zip(scale, names)]
@@ -198,7 +198,8 @@ def main():
                           {"label": "GFP", "color": "00FF00", "active": True,
                            "window": {"start": 0, "end": 65535, "min": 0, "max": 65535}}]}
     cases.append(write_case(outdir, "omero", list("czyx"), (2, 5, 6, 7), (1, 5, 6, 7), "<u2",
-                            COMPRESSORS["zlib"], ".", omero=omero, seed=303))
+                            COMPRESSORS["zlib"], ".", omero=omero, seed=303,
+                            translation=[0.0, 1.5, -2.0, 3.0]))
     with open(os.path.join(outdir, "manifest.json"), "w") as f:
         json.dump({"cases": cases}, f, indent=1)
 

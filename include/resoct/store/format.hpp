@@ -52,14 +52,19 @@ inline constexpr std::uint64_t metadata_crc = 176;
 /// 0: the values are voxel_type's own; else the DataType code (3..7) of the file the store was
 /// converted from, whose data_mapping() gives voxel_type (VolumeDesc::data_type).
 inline constexpr std::uint64_t data_type = 180;
-inline constexpr std::uint64_t ranges = 184;  // channels x (f64 lo, f64 hi), then the CRC
+inline constexpr std::uint64_t ranges = 184;  // channels x (f64 lo, f64 hi), [origin], the CRC
 /// Fixed part before the ranges plus the trailing CRC.
 inline constexpr std::uint64_t fixed_size = 188;
 }  // namespace hdr
 
 /// Header flag: the volume had no explicit value ranges (the stored ones are the defaults).
 inline constexpr std::uint32_t kFlagDefaultRanges = 1u << 0;
-inline constexpr std::uint32_t kKnownFlags = kFlagDefaultRanges;
+/// Header flag: 3 f64 (the volume's origin, VolumeDesc::origin) follow the ranges. Set only for
+/// an origin other than 0, so stores of unplaced volumes stay byte-identical to those written
+/// before the flag existed; a reader that does not know the flag refuses the file
+/// (Error(unsupported)) instead of silently misplacing it.
+inline constexpr std::uint32_t kFlagOrigin = 1u << 1;
+inline constexpr std::uint32_t kKnownFlags = kFlagDefaultRanges | kFlagOrigin;
 
 /// Index entry flags.
 inline constexpr std::uint32_t kEntryStored = 1u << 0;    ///< a payload exists
@@ -70,8 +75,8 @@ inline constexpr std::uint64_t kIndexEntrySize = 40;
 /// Bytes per finest metadata block in the raw metadata section (f64 min, f64 max, u32 bits).
 inline constexpr std::uint64_t kMetaEntrySize = 20;
 
-constexpr std::uint64_t header_size_for(std::uint32_t channels) noexcept {
-  return hdr::fixed_size + 16u * std::uint64_t(channels);
+constexpr std::uint64_t header_size_for(std::uint32_t channels, std::uint32_t flags) noexcept {
+  return hdr::fixed_size + 16u * std::uint64_t(channels) + ((flags & kFlagOrigin) != 0 ? 24u : 0u);
 }
 
 struct StoreHeader {
@@ -106,7 +111,7 @@ struct IndexEntry {
   std::uint32_t fill_bits = 0;
 };
 
-/// The encoded header (header_size_for(channels) bytes, CRC included).
+/// The encoded header (header_size_for(channels, flags) bytes, CRC included).
 std::vector<std::byte> encode_header(const StoreHeader& h);
 
 /// Reads and validates the header of `file` (magic, size, CRC, version, every field, section
