@@ -124,7 +124,8 @@ class Renderer {
 
   /// One frame: maps the scene's channels to slots, applies loaded bricks within the upload
   /// budget, sends deltas, renders, and hands the frame's requests to the loader. A scene of
-  /// another timepoint than the last frame's first switches (docs/renderer.md "Time series"):
+  /// another timepoint than the last frame's (an absent Scene::timepoint meaning the source's
+  /// own) first switches (docs/renderer.md "Time series"):
   /// every brick and node summary of the old timepoint is invalidated, so the frame shows only
   /// the new timepoint, coarse levels first. Throws Error(invalid_argument) naming "scene" when
   /// it is invalid for the volume (its `timepoint` past the source's) or has more channels than

@@ -95,8 +95,10 @@ struct Scene {
   /// 1..16; paper 004 §7.2 suggests 2).
   std::uint32_t shadow_lod_factor = 2;
   /// The timepoint of a time series to show (docs/scene.md "Time series"); must be below the
-  /// source's BrickSource::timepoints(), so 0 for data without a time axis.
-  std::uint32_t timepoint = 0;
+  /// source's BrickSource::timepoints(), so 0 for data without a time axis. Absent: the
+  /// timepoint the source was opened at (BrickSource::timepoint(), e.g.
+  /// OmeZarrOptions::timepoint), so scenes without the field show what they showed before.
+  std::optional<std::uint32_t> timepoint;
 
   /// Whether the scene declares `e`.
   bool has_effect(Effect e) const noexcept;

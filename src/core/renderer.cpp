@@ -538,8 +538,9 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   stats.frame_index = frame_;
 
   auto t = Clock::now();
-  if (scene.timepoint != timepoint_) {
-    switch_timepoint(scene.timepoint);
+  if (const std::uint32_t wanted = scene.timepoint.value_or(source_->timepoint());
+      wanted != timepoint_) {
+    switch_timepoint(wanted);
     stats.timepoint_switched = true;
   }
   stats.timepoint = timepoint_;

@@ -447,9 +447,9 @@ void Scene::validate(const VolumeDesc& volume, const std::string& what) const {
 void Scene::validate(const VolumeDesc& volume, std::uint32_t timepoints,
                      const std::string& what) const {
   validate(volume, what);
-  if (timepoint >= timepoints) {
+  if (timepoint && *timepoint >= timepoints) {
     throw Error(ErrorCode::invalid_argument,
-                what + ": timepoint: " + std::to_string(timepoint) + " but the volume has " +
+                what + ": timepoint: " + std::to_string(*timepoint) + " but the volume has " +
                     std::to_string(timepoints) + " timepoint" + (timepoints == 1 ? "" : "s") +
                     " (0.." + std::to_string(timepoints == 0 ? 0 : timepoints - 1) + ")");
   }
@@ -557,7 +557,7 @@ std::string scene_to_json(const Scene& s) {
   doc["effects"] = effects;
   // Written only when on, so that documents of scenes without it are unchanged.
   if (s.preintegration) doc["preintegration"] = true;
-  if (s.timepoint != 0) doc["timepoint"] = s.timepoint;  // likewise
+  if (s.timepoint) doc["timepoint"] = *s.timepoint;  // likewise, only when given
   detail::slices_and_lens_to_json(s, doc);
   effects_to_json(s, doc);
   return doc.dump(2) + "\n";

@@ -133,6 +133,20 @@ TEST_P(TimeSeriesPlayback, TheFrameThatSwitchesShowsNothingOfThePreviousTimepoin
   EXPECT_TRUE(same_bytes(back.last.image, fresh0.render_until_converged(scene, 64).last.image));
 }
 
+TEST_P(TimeSeriesPlayback, ASceneWithoutATimepointShowsTheOneTheSourceWasOpenedAt) {
+  const auto opened_at_2 = make_moving_ball_series(5, 2);
+  Renderer r(opened_at_2, options_);
+  EXPECT_EQ(r.timepoint(), 2u);
+  Scene scene = ball_scene();  // no timepoint
+  const ConvergeReport own = r.render_until_converged(scene, 64);
+  ASSERT_TRUE(own.converged);
+  EXPECT_EQ(own.last.stats.timepoint, 2u);
+  EXPECT_EQ(r.loader().stats().timepoint_switches, 0u);
+  scene.timepoint = 2;
+  Renderer from_0(make_moving_ball_series(5), options_);
+  EXPECT_TRUE(same_bytes(own.last.image, from_0.render_until_converged(scene, 64).last.image));
+}
+
 TEST_P(TimeSeriesPlayback, ATimepointPastTheSeriesNamesTheField) {
   const auto series = make_moving_ball_series(5);
   Renderer player(series, options_);

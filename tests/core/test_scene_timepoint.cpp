@@ -22,11 +22,14 @@ TEST(SceneTimepoint, ParsesAndRoundTrips) {
   EXPECT_EQ(s.timepoint, 3u);
   EXPECT_EQ(parse_scene(scene_to_json(s)), s);
   EXPECT_NE(scene_to_json(s).find("\"timepoint\": 3"), std::string::npos);
-  // Absent means 0, and 0 is not written, so documents of scenes without a series stay as
-  // they were.
-  const Scene zero = parse_scene(scene_text(""));
+  // Absent stays absent (the source's own timepoint) and is not written, so documents of
+  // scenes without a series stay as they were; an explicit 0 is kept.
+  const Scene absent = parse_scene(scene_text(""));
+  EXPECT_FALSE(absent.timepoint.has_value());
+  EXPECT_EQ(scene_to_json(absent).find("timepoint"), std::string::npos);
+  EXPECT_EQ(parse_scene(scene_to_json(absent)), absent);
+  const Scene zero = parse_scene(scene_text(R"(, "timepoint": 0)"));
   EXPECT_EQ(zero.timepoint, 0u);
-  EXPECT_EQ(scene_to_json(zero).find("timepoint"), std::string::npos);
   EXPECT_EQ(parse_scene(scene_to_json(zero)), zero);
 }
 
@@ -51,6 +54,8 @@ TEST(SceneTimepoint, ValidatesAgainstTheSourcesTimepoints) {
   s.timepoint = 1;
   EXPECT_RESOCT_ERROR(s.validate(v, 1, "scene"), ErrorCode::invalid_argument,
                       "scene: timepoint: 1 but the volume has 1 timepoint (0..0)");
+  s.timepoint.reset();  // absent: whatever the source reads
+  EXPECT_NO_THROW(s.validate(v, 1, "scene"));
 }
 
 }  // namespace
