@@ -90,7 +90,10 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
                  {"stored_type", std::string(to_string(v.type))},
                  {"value_offset", mapping.offset},
                  {"exact", mapping.exact},
-                 {"ranges", ranges}};
+                 {"ranges", ranges},
+                 // A time series: the count, and which timepoint the rest describes.
+                 {"timepoints", src.timepoints()},
+                 {"timepoint", src.timepoint()}};
   j["layout"] = {{"brick_size", vec(h.layout().brick_size)},
                  {"halo", h.layout().halo},
                  {"padded_size", vec(h.layout().padded_size())},
@@ -153,6 +156,10 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
   // Where the volume sits (the low corner of voxel 0, docs/formats.md "Physical placement").
   std::printf("  origin   %g, %g, %g\n", v.origin.x, v.origin.y, v.origin.z);
   std::printf("  ranges   %s\n", ranges_text(v).c_str());
+  if (src.timepoints() > 1) {
+    std::printf("  time     %u timepoints (this is timepoint %u)\n", src.timepoints(),
+                src.timepoint());
+  }
   std::printf("  bricks   %s core, halo %u, %s padded (%s each)\n", xyz(lay.brick_size).c_str(),
               lay.halo, xyz(lay.padded_size()).c_str(),
               format_bytes(padded_brick_bytes(h)).c_str());

@@ -54,6 +54,26 @@ struct Args {
   std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
   std::string strategy = "greedy";
   std::uint32_t leaf = 16;
+  std::optional<std::uint32_t> timepoint;  // overrides the scene's
+  std::string play;                        // "FIRST:LAST": one image per timepoint
+  bool no_play_prefetch = false;
+};
+
+/// The --out path of timepoint t while playing: "{t}" replaced by the timepoint.
+std::string out_path_of(const std::string& pattern, std::uint32_t t) {
+  std::string out = pattern;
+  for (std::size_t p; (p = out.find("{t}")) != std::string::npos;) {
+    out.replace(p, 3, std::to_string(t));
+  }
+  return out;
+}
+
+/// One converged (or frame-capped) image of one timepoint while playing.
+struct PlayedTimepoint {
+  std::uint32_t timepoint = 0;
+  std::uint32_t frames = 0;
+  bool converged = false;
+  double ms = 0.0;  // wall time of its frames
 };
 
 RequestStrategy parse_strategy(const std::string& s) {
@@ -88,7 +108,7 @@ double per_ray(std::uint64_t v, std::uint64_t rays) {
 
 void write_stats(const std::string& path, const Args& a, const FrameReport& last,
                  std::uint32_t frames, bool converged, double steady_ms, std::uint32_t steady_count,
-                 const Totals& t, const Renderer& r) {
+                 const Totals& t, const Renderer& r, const std::vector<PlayedTimepoint>& played) {
   const FrameStats& s = last.stats;
   nlohmann::json j;
   j["volume"] = a.volume;
@@ -123,6 +143,23 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   j["bytes_uploaded"] = t.bytes_uploaded;
   j["loads"] = r.loader().stats().loads;
   j["host_cache_hits"] = r.loader().stats().host_hits;
+  // Time series (docs/renderer.md "Time series").
+  const BrickLoaderStats ls = r.loader().stats();
+  j["timepoint"] = r.timepoint();
+  j["timepoints"] = r.timepoints();
+  j["prefetched"] = ls.prefetched;
+  j["prefetch_hits"] = ls.prefetch_hits;
+  j["stale_loads_dropped"] = ls.stale_dropped;
+  if (!a.play.empty()) {
+    nlohmann::json p = nlohmann::json::array();
+    for (const PlayedTimepoint& x : played) {
+      p.push_back({{"timepoint", x.timepoint},
+                   {"frames", x.frames},
+                   {"converged", x.converged},
+                   {"ms", x.ms}});
+    }
+    j["play"] = p;
+  }
   nlohmann::json f = nlohmann::json::array();
   for (const LoadFailure& x : t.failures) f.push_back(x.message);
   j["load_failures"] = f;
@@ -172,15 +209,41 @@ int run(const Args& a) {
   o.leaf_size = glm::uvec3(a.leaf);
   if (a.frames == 0 && !a.converge)
     throw invalid_parameter("frames", "give --frames N or --converge");
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> play;
+  if (!a.play.empty()) {
+    play = resoct::tools::parse_index_range(a.play, "play");
+    if (!a.out.empty() && a.out.find("{t}") == std::string::npos) {
+      throw invalid_parameter("out", "with --play it must contain {t} (one image per timepoint)");
+    }
+    // While one timepoint is shown, the loader reads the next one's bricks into host memory.
+    o.prefetch.next_timepoint = !a.no_play_prefetch;
+  }
   // Both outputs are checked before rendering: a bad --stats path must not fail after the PNG
   // has already replaced an existing one, nor after minutes of rendering.
-  if (!a.out.empty()) resoct::tools::check_output_path("out", a.out);
+  if (!a.out.empty()) {
+    resoct::tools::check_output_path("out", play ? out_path_of(a.out, play->first) : a.out);
+  }
   if (!a.stats.empty()) resoct::tools::check_output_path("stats", a.stats);
 
   Scene scene = load_scene(a.scene);
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
   Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
+  // Checked before rendering, naming the option rather than the scene field.
+  const std::uint32_t timepoints = renderer.timepoints();
+  const auto check_timepoint = [&](const char* option, std::uint32_t t) {
+    if (t >= timepoints) {
+      throw invalid_parameter(option, std::to_string(t) + " but " + a.volume + " has " +
+                                          std::to_string(timepoints) + " timepoint" +
+                                          (timepoints == 1 ? "" : "s") + " (0.." +
+                                          std::to_string(timepoints - 1) + ")");
+    }
+  };
+  if (a.timepoint) {
+    check_timepoint("timepoint", *a.timepoint);
+    scene.timepoint = *a.timepoint;
+  }
+  if (play) check_timepoint("play", play->second);
   renderer.set_failure_callback([](const LoadFailure& f) {
     std::fprintf(stderr, "resoct-render: warning: %s\n", f.message.c_str());
   });
@@ -197,23 +260,45 @@ int run(const Args& a) {
     return last.converged;
   };
   std::vector<double> ms;  // render_frame wall time of every frame
-  if (a.converge) {
-    while (frames < a.max_frames && !(converged = frame())) {
+  // One image: until converged (capped by --max-frames) or exactly --frames frames.
+  const auto render_image = [&] {
+    const std::uint32_t start = frames;
+    if (a.converge) {
+      while (frames - start < a.max_frames && !(converged = frame())) {
+        ms.push_back(last.stats.ms_frame);
+        // Frames while loads run would only re-render the same state; wait for them.
+        renderer.wait_for_loads();
+      }
       ms.push_back(last.stats.ms_frame);
-      // Frames while loads run would only re-render the same state; wait for them.
-      renderer.wait_for_loads();
+    } else {
+      for (std::uint32_t i = 0; i < a.frames; ++i) {
+        converged = frame();
+        ms.push_back(last.stats.ms_frame);
+      }
     }
-    ms.push_back(last.stats.ms_frame);
-    // Steady state: extra frames after convergence, which load and upload nothing.
-    for (std::uint32_t i = 0; converged && i < a.steady_frames; ++i) {
-      frame();
-      ms.push_back(last.stats.ms_frame);
+  };
+  std::vector<PlayedTimepoint> played;
+  if (play) {
+    for (std::uint32_t t = play->first;; ++t) {
+      scene.timepoint = t;
+      const std::size_t first_frame = ms.size();
+      const std::uint32_t before = frames;
+      render_image();
+      PlayedTimepoint p{t, frames - before, converged, 0.0};
+      for (std::size_t i = first_frame; i < ms.size(); ++i) p.ms += ms[i];
+      played.push_back(p);
+      std::fprintf(stderr, "resoct-render: timepoint %u: %u frames, %s\n", t, p.frames,
+                   converged ? "converged" : "not converged");
+      if (!a.out.empty()) write_png(last.image, out_path_of(a.out, t));
+      if (t == play->second) break;
     }
   } else {
-    for (std::uint32_t i = 0; i < a.frames; ++i) {
-      converged = frame();
-      ms.push_back(last.stats.ms_frame);
-    }
+    render_image();
+  }
+  // Steady state: extra frames after convergence, which load and upload nothing.
+  for (std::uint32_t i = 0; a.converge && converged && i < a.steady_frames; ++i) {
+    frame();
+    ms.push_back(last.stats.ms_frame);
   }
   // ms_per_frame_steady: mean over the last steady_frames frames (the extra frames after
   // convergence with --converge); fewer when fewer were rendered.
@@ -235,9 +320,9 @@ int run(const Args& a) {
     }
   }
 #endif
-  if (!a.out.empty()) write_png(last.image, a.out);
+  if (!a.out.empty() && !play) write_png(last.image, a.out);
   if (!a.stats.empty()) {
-    write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer);
+    write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer, played);
   }
   std::fprintf(stderr, "resoct-render: %u frames, %s, %.2f ms/frame steady\n", frames,
                converged ? "converged" : "not converged", steady);
@@ -274,6 +359,14 @@ int main(int argc, char** argv) {
   app.add_option("--strategy", a.strategy, "greedy | global")->capture_default_str();
   app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
       ->capture_default_str();
+  auto* timepoint = app.add_option("--timepoint", a.timepoint,
+                                   "timepoint of a time series (overrides the scene's)");
+  app.add_option("--play", a.play,
+                 "FIRST:LAST: one image per timepoint, prefetching the next one; --out must "
+                 "contain {t}")
+      ->excludes(timepoint);
+  app.add_flag("--no-play-prefetch", a.no_play_prefetch,
+               "with --play: do not prefetch the next timepoint (for comparisons)");
   resoct::tools::one_line_usage_errors(app, "resoct-render");
   try {
     app.parse(argc, argv);

@@ -86,6 +86,17 @@ ValueRange parse_range(std::string_view s, std::string_view option) {
   return r;
 }
 
+std::pair<std::uint32_t, std::uint32_t> parse_index_range(std::string_view s,
+                                                          std::string_view option) {
+  const auto parts = split(s, ':');
+  std::uint32_t first = 0, last = 0;
+  if (parts.size() != 2 || !parse_number(parts[0], first) || !parse_number(parts[1], last) ||
+      first > last) {
+    throw bad(option, "FIRST:LAST with integers FIRST <= LAST", s);
+  }
+  return {first, last};
+}
+
 std::string format_bytes(std::uint64_t bytes) {
   static constexpr const char* kUnits[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB"};
   double v = double(bytes);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <glm/vec3.hpp>
 
@@ -24,6 +25,9 @@ glm::uvec3 parse_brick(std::string_view s, std::string_view option);
 glm::dvec3 parse_spacing(std::string_view s, std::string_view option);
 /// "LO,HI" with finite LO < HI.
 ValueRange parse_range(std::string_view s, std::string_view option);
+/// "FIRST:LAST" with integers FIRST <= LAST < 2^32 (an inclusive range of timepoints).
+std::pair<std::uint32_t, std::uint32_t> parse_index_range(std::string_view s,
+                                                          std::string_view option);
 
 /// "512 B", "1.5 KiB", "3.2 MiB", "1.1 GiB".
 std::string format_bytes(std::uint64_t bytes);

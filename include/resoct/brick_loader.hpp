@@ -21,6 +21,8 @@
 #include "resoct/brick_source.hpp"
 #include "resoct/eviction_policy.hpp"
 #include "resoct/host_brick_cache.hpp"
+#include "resoct/timed_brick_key.hpp"
+#include "resoct/timepoint_sources.hpp"
 
 namespace resoct {
 
@@ -58,6 +60,10 @@ struct BrickLoaderStats {
   std::uint64_t duplicates = 0;  ///< requests ignored: already queued, in flight, ready or failed
   std::uint64_t prefetched = 0;  ///< bricks read into the host cache by prefetch()
   std::uint64_t prefetch_hits = 0;  ///< requests served by the host cache thanks to a prefetch
+  /// Loads of an earlier timepoint that completed after set_timepoint() switched away: never
+  /// delivered (their bricks stay in the host cache under their own timepoint).
+  std::uint64_t stale_dropped = 0;
+  std::uint64_t timepoint_switches = 0;  ///< set_timepoint() calls that changed the timepoint
 };
 
 /// Loading order: coarser level first, then lower channel rank, then older (smaller `since`),
@@ -70,6 +76,12 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 /// priority queue whose bricks go into the host cache only (a worker takes one only while no
 /// request is queued). With 0 threads nothing happens in the background and run_queued() /
 /// run_prefetch() load on the calling thread, which makes tests deterministic.
+///
+/// Time series: requests, ready bricks and failures belong to the current timepoint
+/// (set_timepoint()); switching drops them, and loads of the old timepoint still running are
+/// marked stale and never delivered, so the frame loop can never receive a brick of another
+/// timepoint than the one it renders. Prefetch keys carry their timepoint (the next one while
+/// playing). The host cache keys bricks by (key, timepoint).
 /// Thread-safety: all members may be called from any thread; the worker threads are internal.
 class BrickLoader {
  public:
@@ -84,7 +96,17 @@ class BrickLoader {
   BrickLoader& operator=(const BrickLoader&) = delete;
 
   std::uint32_t thread_count() const noexcept { return std::uint32_t(workers_.size()); }
-  const BrickSource& source() const noexcept { return *source_; }
+  /// The series' source as given to the constructor.
+  const BrickSource& source() const noexcept { return *sources_->series(); }
+  /// The series' timepoint sources (shared with the renderer for region metadata).
+  TimepointSources& timepoint_sources() noexcept { return *sources_; }
+  /// The timepoint requests are loaded from (initially the source's own).
+  std::uint32_t timepoint() const;
+  /// Makes `t` the current timepoint: queued and ready requests, adoptions and the failed set
+  /// (failures are per timepoint) are dropped, loads in flight become stale (completed into the
+  /// host cache, never delivered). Nothing happens when t is already current. Throws as
+  /// TimepointSources::at (Error naming "timepoint" when t >= timepoints()), changing nothing.
+  void set_timepoint(std::uint32_t t);
 
   /// The new queue: `wanted` minus keys in flight, ready or failed, deduplicated, in load_before
   /// order. Queued keys not in `wanted` are cancelled.
@@ -96,11 +118,14 @@ class BrickLoader {
   /// only; if a request() for it arrives while it loads, it is delivered like a requested one.
   /// A prefetch that fails marks the key failed and is reported like a failed request.
   void prefetch(std::span<const BrickKey> keys);
+  /// The same with keys of any timepoint (the next one while playing). A prefetch of another
+  /// than the current timepoint that fails is not recorded: a later request reports it.
+  void prefetch(std::span<const TimedBrickKey> keys);
   /// Loads up to `max` prefetch keys on the calling thread; returns how many were loaded.
   std::size_t run_prefetch(std::size_t max);
   std::size_t prefetch_queued() const;
-  /// Blocks until nothing is queued or in flight, prefetches included (for tools and tests with
-  /// threads).
+  /// Blocks until nothing is queued or in flight, prefetches and stale loads included (for tools
+  /// and tests with threads).
   void wait_idle();
 
   /// Loaded bricks not yet taken, in load_before order; the ready list is emptied.
@@ -121,18 +146,35 @@ class BrickLoader {
 
  private:
   void worker_main();
+  /// A request popped with the timepoint generation it belongs to.
+  struct Job {
+    LoadRequest request;
+    std::uint32_t timepoint = 0;
+    std::uint64_t generation = 0;
+    std::shared_ptr<const BrickSource> source;
+  };
   /// Pops the best queued request; caller holds mutex_ and the queue is not empty.
-  LoadRequest pop_locked();
+  Job pop_locked();
   /// Pops the next prefetch key still worth loading and marks it loading; caller holds mutex_.
-  std::optional<BrickKey> pop_prefetch_locked();
-  /// Loads one brick without holding mutex_ and files the result.
-  void load_one(const LoadRequest& r);
-  /// Reads a brick into the host cache; the failure message when it throws.
-  std::shared_ptr<const HostBrick> read_brick(BrickKey key, std::string& failure);
+  std::optional<TimedBrickKey> pop_prefetch_locked();
+  /// True when nothing needs loading for `k` (queued, loading, ready, failed or cached);
+  /// caller holds mutex_.
+  bool known_locked(const TimedBrickKey& k) const;
+  /// Loads one brick without holding mutex_ and files the result (or drops it as stale).
+  void load_one(const Job& job);
+  /// Reads a brick of `source` (timepoint `t`) into the host cache; the failure message when it
+  /// throws.
+  std::shared_ptr<const HostBrick> read_brick(const BrickSource& source, BrickKey key,
+                                              std::uint32_t t, std::string& failure);
   /// Loads one prefetch key without holding mutex_.
-  void prefetch_one(BrickKey key);
+  void prefetch_one(const TimedBrickKey& key);
 
-  std::shared_ptr<const BrickSource> source_;
+  std::shared_ptr<TimepointSources> sources_;
+  std::shared_ptr<const BrickSource> current_;  // source of timepoint_
+  std::uint32_t timepoint_ = 0;
+  // Bumped by every switch: a job of an older generation is stale when it completes.
+  std::uint64_t generation_ = 0;
+  std::size_t stale_in_flight_ = 0;
   HostBrickCache cache_;
   mutable std::mutex mutex_;
   std::condition_variable work_cv_;
@@ -143,9 +185,9 @@ class BrickLoader {
   std::unordered_set<BrickKey> in_flight_;
   std::unordered_map<BrickKey, LoadedBrick> ready_;
   std::unordered_set<BrickKey> failed_;
-  std::deque<BrickKey> prefetch_;  // front loads first
-  std::unordered_set<BrickKey> prefetching_;
-  std::unordered_set<BrickKey> prefetched_;  // in the host cache by prefetch, not yet requested
+  std::deque<TimedBrickKey> prefetch_;  // front loads first
+  std::unordered_set<TimedBrickKey> prefetching_;
+  std::unordered_set<TimedBrickKey> prefetched_;  // in the host cache by prefetch, not requested
   // Requested while their prefetch was loading: delivered when it completes, not read twice.
   std::unordered_map<BrickKey, LoadRequest> adopted_;
   std::vector<LoadFailure> new_failures_;

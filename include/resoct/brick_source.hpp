@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <string>
 
@@ -73,11 +74,35 @@ class BrickSource {
   /// Human-readable name for messages: a path, a URL or "procedural:tubes:256x256x256".
   virtual std::string name() const = 0;
 
+  // --- Time series (docs/renderer.md "Time series") --------------------------------------------
+  // A source reads one timepoint of a series; every member above answers for that timepoint.
+  // The other timepoints are separate sources (open_timepoint) with the same hierarchy, so that
+  // everything derived from the data -- brick metadata, region metadata, computed levels and
+  // their caches -- is per timepoint by construction and can never leak into another one.
+
+  /// Timepoints of the series this source belongs to; 1 for data without a time axis.
+  virtual std::uint32_t timepoints() const { return 1; }
+  /// The timepoint this source reads, < timepoints().
+  virtual std::uint32_t timepoint() const { return 0; }
+  /// A source reading timepoint `t` (< timepoints(), != timepoint()) of the same series, with an
+  /// identical hierarchy (value ranges included, so that a transfer function maps every
+  /// timepoint alike). Called rarely (on a timepoint switch or prefetch of the next one); use
+  /// source_at_timepoint(), which also handles t == timepoint(). The default throws
+  /// Error(invalid_argument) naming "timepoint": a single-timepoint source has no other.
+  virtual std::shared_ptr<const BrickSource> open_timepoint(std::uint32_t t) const;
+
  protected:
   /// Throws Error(out_of_range) naming this source when `key` is not in the hierarchy, and
   /// Error(invalid_argument) when `out` has the wrong size.
   void check_brick_request(BrickKey key, std::span<const std::byte> out) const;
 };
+
+/// `source` itself when t == source->timepoint(), else source->open_timepoint(t) after checking
+/// that its hierarchy equals the series' one. Throws Error(invalid_argument) naming "timepoint"
+/// when t >= timepoints(), Error(corrupt) naming the source when the opened timepoint's hierarchy
+/// differs, and what open_timepoint throws.
+std::shared_ptr<const BrickSource> source_at_timepoint(std::shared_ptr<const BrickSource> source,
+                                                       std::uint32_t t);
 
 /// Scans a padded brick buffer of type `t` for its metadata (NaN ignored).
 BrickMeta scan_brick(std::span<const std::byte> voxels, VoxelType t);

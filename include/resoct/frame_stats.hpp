@@ -27,6 +27,10 @@ struct FrameStats {
   std::uint64_t loads_queued = 0;     ///< loader queue after this frame's request
   std::uint64_t loads_in_flight = 0;  ///< bricks being read when the frame ended
   std::uint64_t prefetch_queued = 0;  ///< bricks queued for prefetching this frame
+  /// Of them, bricks of the next timepoint (PrefetchOptions::next_timepoint).
+  std::uint64_t prefetch_next_timepoint = 0;
+  std::uint32_t timepoint = 0;        ///< the timepoint this frame showed
+  bool timepoint_switched = false;    ///< the frame began by switching to `timepoint`
   std::uint64_t bricks_uploaded = 0;  ///< cache slots written
   std::uint64_t bytes_uploaded = 0;
   std::uint64_t pages_empty = 0;        ///< bricks mapped EMPTY (all zero) this frame

@@ -15,6 +15,7 @@
 #include "resoct/brick_key.hpp"
 #include "resoct/brick_source.hpp"
 #include "resoct/eviction_policy.hpp"
+#include "resoct/timed_brick_key.hpp"
 
 namespace resoct {
 
@@ -22,6 +23,9 @@ namespace resoct {
 /// constant brick needs no cache slot, so its voxels are not kept).
 struct HostBrick {
   BrickKey key;
+  /// The timepoint it was read from (0 without a time axis): entries are keyed by both, so
+  /// bricks of several timepoints (the shown one, the next one prefetched) live side by side.
+  std::uint32_t timepoint = 0;
   BrickMeta meta;
   std::vector<std::byte> voxels;  ///< empty when meta.constant
 };
@@ -64,12 +68,12 @@ class HostBrickCache {
   /// The frame that later uses and insertions are recorded with (the renderer's frame).
   void set_frame(std::uint64_t frame);
 
-  /// The brick, recorded as used; nullptr when absent (counted as hit or miss).
-  std::shared_ptr<const HostBrick> get(BrickKey key);
+  /// The brick of `timepoint`, recorded as used; nullptr when absent (counted as hit or miss).
+  std::shared_ptr<const HostBrick> get(BrickKey key, std::uint32_t timepoint = 0);
   /// True when present; does not change the use order or the statistics.
-  bool contains(BrickKey key) const;
-  /// Inserts or replaces a brick as used now, then evicts the policy's victims until the total
-  /// fits.
+  bool contains(BrickKey key, std::uint32_t timepoint = 0) const;
+  /// Inserts or replaces a brick (under its key and timepoint) as used now, then evicts the
+  /// policy's victims until the total fits.
   void put(std::shared_ptr<const HostBrick> brick);
   void clear();
 
@@ -95,7 +99,7 @@ class HostBrickCache {
   std::vector<Entry> entries_;   // by policy slot
   std::vector<CacheSlot> pins_;  // last_use = operation sequence: only the current op pins
   std::vector<std::uint32_t> free_;
-  std::unordered_map<BrickKey, std::uint32_t> index_;
+  std::unordered_map<TimedBrickKey, std::uint32_t> index_;
   std::uint64_t frame_ = 0;
   std::uint64_t seq_ = 0;
   std::uint64_t bytes_ = 0;

@@ -39,10 +39,16 @@ namespace resoct {
 /// up to `max_bricks` / `max_bytes` (padded voxel bytes) bricks those views may need and that are
 /// neither on the device nor in the host cache are queued for loading into the host cache, below
 /// every real request.
+///
+/// Playing a time series (`next_timepoint`): each frame also queues, below the camera's
+/// prefetches, up to the same budget of bricks of the next timepoint (scene timepoint + 1,
+/// wrapping to 0) that the current view may need and the host cache lacks, so that switching to
+/// it is served from host memory (docs/renderer.md "Time series").
 struct PrefetchOptions {
   std::uint32_t lookahead_frames = 0;                 ///< 0 disables prefetching; at most 64
   std::uint32_t max_bricks = 64;                      ///< per frame, > 0 when enabled
   std::uint64_t max_bytes = std::uint64_t(64) << 20;  ///< per frame, > 0 when enabled
+  bool next_timepoint = false;  ///< prefetch the next timepoint (no effect without a t axis)
 };
 
 /// Construction parameters of a Renderer; validate() names the offending field.
@@ -117,12 +123,21 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   /// One frame: maps the scene's channels to slots, applies loaded bricks within the upload
-  /// budget, sends deltas, renders, and hands the frame's requests to the loader. Throws
-  /// Error(invalid_argument) naming "scene" when it is invalid for the volume or has more channels
-  /// than visible slots.
+  /// budget, sends deltas, renders, and hands the frame's requests to the loader. A scene of
+  /// another timepoint than the last frame's (an absent Scene::timepoint meaning the source's
+  /// own) first switches (docs/renderer.md "Time series"):
+  /// every brick and node summary of the old timepoint is invalidated, so the frame shows only
+  /// the new timepoint, coarse levels first. Throws Error(invalid_argument) naming "scene" when
+  /// it is invalid for the volume (its `timepoint` past the source's) or has more channels than
+  /// visible slots.
   FrameReport render_frame(const Scene& scene);
   /// Renders until a frame reports converged or `max_frames` frames were rendered (>= 1).
   ConvergeReport render_until_converged(const Scene& scene, std::uint32_t max_frames);
+
+  /// The timepoint the last frame showed (the source's own before the first frame).
+  std::uint32_t timepoint() const noexcept { return timepoint_; }
+  /// Timepoints of the source (BrickSource::timepoints()).
+  std::uint32_t timepoints() const noexcept { return source_->timepoints(); }
 
   /// Blocks until the loader has nothing queued or in flight (returns at once with 0 threads).
   void wait_for_loads() { loader_->wait_idle(); }
@@ -148,6 +163,10 @@ class Renderer {
  private:
   const FrameTables& frame_tables(const Scene& scene);
   void assign_channels(const Scene& scene);
+  void switch_timepoint(std::uint32_t t);
+  /// Bricks of the next timepoint the scene's view may need, for PrefetchOptions::next_timepoint.
+  void prefetch_next_timepoint(const Scene& scene, std::size_t max,
+                               std::vector<TimedBrickKey>& keys);
   void apply_loaded(FrameStats& stats);
   bool apply_one(const LoadedBrick& b, FrameStats& stats);
   void evict(BrickKey key);
@@ -158,6 +177,9 @@ class Renderer {
   void report_failures(FrameReport& report);
 
   std::shared_ptr<const BrickSource> source_;
+  // The shown timepoint and its source (region metadata is per timepoint).
+  std::uint32_t timepoint_ = 0;
+  std::shared_ptr<const BrickSource> timepoint_source_;
   RendererOptions options_;
   BrickHierarchy hierarchy_;
   OctreeLayout layout_;

@@ -94,6 +94,11 @@ struct Scene {
   /// Shadow rays march a level whose voxels are this many times the view LOD's (power of two,
   /// 1..16; paper 004 §7.2 suggests 2).
   std::uint32_t shadow_lod_factor = 2;
+  /// The timepoint of a time series to show (docs/scene.md "Time series"); must be below the
+  /// source's BrickSource::timepoints(), so 0 for data without a time axis. Absent: the
+  /// timepoint the source was opened at (BrickSource::timepoint(), e.g.
+  /// OmeZarrOptions::timepoint), so scenes without the field show what they showed before.
+  std::optional<std::uint32_t> timepoint;
 
   /// Whether the scene declares `e`.
   bool has_effect(Effect e) const noexcept;
@@ -105,6 +110,10 @@ struct Scene {
   void validate(const std::string& what = "scene") const;
   /// validate(), plus every channel must exist in `volume`.
   void validate(const VolumeDesc& volume, const std::string& what = "scene") const;
+  /// The same, plus `timepoint` must be below `timepoints` (the source's count):
+  /// "<what>: timepoint: 7 but the volume has 5 timepoints (0..4)".
+  void validate(const VolumeDesc& volume, std::uint32_t timepoints,
+                const std::string& what = "scene") const;
 
   friend bool operator==(const Scene&, const Scene&) = default;
 };

@@ -19,8 +19,11 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept {
 BrickLoader::BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
                          std::uint64_t host_cache_bytes,
                          std::unique_ptr<EvictionPolicy> host_policy)
-    : source_(std::move(source)), cache_(host_cache_bytes, std::move(host_policy)) {
-  if (!source_) throw invalid_parameter("source", "must not be null");
+    : cache_(host_cache_bytes, std::move(host_policy)) {
+  if (!source) throw invalid_parameter("source", "must not be null");
+  sources_ = std::make_shared<TimepointSources>(std::move(source));
+  current_ = sources_->series();
+  timepoint_ = current_->timepoint();
   if (threads > 1024) throw invalid_parameter("threads", "must be at most 1024");
   workers_.reserve(threads);
   for (std::uint32_t i = 0; i < threads; ++i) workers_.emplace_back([this] { worker_main(); });
@@ -51,7 +54,7 @@ void BrickLoader::request(std::span<const LoadRequest> wanted) {
         ++stats_.duplicates;
         continue;
       }
-      if (prefetching_.count(r.key)) {
+      if (prefetching_.count(TimedBrickKey{r.key, timepoint_})) {
         next_keys.erase(r.key);
         adopted.emplace(r.key, r);
         continue;
@@ -72,38 +75,74 @@ void BrickLoader::request(std::span<const LoadRequest> wanted) {
   idle_cv_.notify_all();
 }
 
-LoadRequest BrickLoader::pop_locked() {
+std::uint32_t BrickLoader::timepoint() const {
+  std::lock_guard lock(mutex_);
+  return timepoint_;
+}
+
+void BrickLoader::set_timepoint(std::uint32_t t) {
+  {
+    std::lock_guard lock(mutex_);
+    if (t == timepoint_) return;
+  }
+  // Opened outside the lock: opening may read metadata (or scan a small level 0).
+  std::shared_ptr<const BrickSource> next = sources_->at(t);
+  {
+    std::lock_guard lock(mutex_);
+    if (t == timepoint_) return;
+    stats_.cancelled += queue_.size();
+    queue_.clear();
+    queued_keys_.clear();
+    ready_.clear();
+    adopted_.clear();
+    failed_.clear();
+    // Still running: they complete into the host cache but are never delivered.
+    stale_in_flight_ += in_flight_.size();
+    in_flight_.clear();
+    ++generation_;
+    timepoint_ = t;
+    current_ = std::move(next);
+    ++stats_.timepoint_switches;
+  }
+  idle_cv_.notify_all();
+}
+
+bool BrickLoader::known_locked(const TimedBrickKey& k) const {
+  if (prefetching_.count(k) || cache_.contains(k.key, k.timepoint)) return true;
+  if (k.timepoint != timepoint_) return false;
+  return queued_keys_.count(k.key) || in_flight_.count(k.key) || ready_.count(k.key) ||
+         failed_.count(k.key);
+}
+
+BrickLoader::Job BrickLoader::pop_locked() {
   const LoadRequest r = queue_.back();
   queue_.pop_back();
   queued_keys_.erase(r.key);
   in_flight_.insert(r.key);
-  return r;
+  return Job{r, timepoint_, generation_, current_};
 }
 
 std::size_t BrickLoader::run_queued(std::size_t max) {
   std::size_t done = 0;
   while (done < max) {
-    LoadRequest r;
+    Job job;
     {
       std::lock_guard lock(mutex_);
       if (queue_.empty()) break;
-      r = pop_locked();
+      job = pop_locked();
     }
-    load_one(r);
+    load_one(job);
     ++done;
   }
   return done;
 }
 
-std::optional<BrickKey> BrickLoader::pop_prefetch_locked() {
+std::optional<TimedBrickKey> BrickLoader::pop_prefetch_locked() {
   while (!prefetch_.empty()) {
-    const BrickKey key = prefetch_.front();
+    const TimedBrickKey key = prefetch_.front();
     prefetch_.pop_front();
     // Requested, loaded or failed since it was queued: nothing left to prefetch.
-    if (queued_keys_.count(key) || in_flight_.count(key) || ready_.count(key) ||
-        failed_.count(key) || prefetching_.count(key) || cache_.contains(key)) {
-      continue;
-    }
+    if (known_locked(key)) continue;
     prefetching_.insert(key);
     return key;
   }
@@ -116,9 +155,9 @@ void BrickLoader::worker_main() {
     work_cv_.wait(lock, [this] { return stop_ || !queue_.empty() || !prefetch_.empty(); });
     if (stop_) return;
     if (!queue_.empty()) {
-      const LoadRequest r = pop_locked();
+      const Job job = pop_locked();
       lock.unlock();
-      load_one(r);
+      load_one(job);
       lock.lock();
       continue;
     }
@@ -132,16 +171,20 @@ void BrickLoader::worker_main() {
 }
 
 void BrickLoader::prefetch(std::span<const BrickKey> keys) {
+  std::vector<TimedBrickKey> timed;
+  timed.reserve(keys.size());
+  const std::uint32_t t = timepoint();
+  for (const BrickKey key : keys) timed.push_back(TimedBrickKey{key, t});
+  prefetch(std::span<const TimedBrickKey>(timed));
+}
+
+void BrickLoader::prefetch(std::span<const TimedBrickKey> keys) {
   {
     std::lock_guard lock(mutex_);
     prefetch_.clear();
-    std::unordered_set<BrickKey> seen;
-    for (const BrickKey key : keys) {
-      if (!seen.insert(key).second || queued_keys_.count(key) || in_flight_.count(key) ||
-          ready_.count(key) || failed_.count(key) || prefetching_.count(key) ||
-          cache_.contains(key)) {
-        continue;
-      }
+    std::unordered_set<TimedBrickKey> seen;
+    for (const TimedBrickKey& key : keys) {
+      if (!seen.insert(key).second || known_locked(key)) continue;
       prefetch_.push_back(key);
     }
   }
@@ -151,7 +194,7 @@ void BrickLoader::prefetch(std::span<const BrickKey> keys) {
 std::size_t BrickLoader::run_prefetch(std::size_t max) {
   std::size_t done = 0;
   while (done < max) {
-    std::optional<BrickKey> key;
+    std::optional<TimedBrickKey> key;
     {
       std::lock_guard lock(mutex_);
       key = pop_prefetch_locked();
@@ -168,13 +211,15 @@ std::size_t BrickLoader::prefetch_queued() const {
   return prefetch_.size();
 }
 
-std::shared_ptr<const HostBrick> BrickLoader::read_brick(BrickKey key, std::string& failure) {
+std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& source, BrickKey key,
+                                                         std::uint32_t t, std::string& failure) {
   try {
     auto b = std::make_shared<HostBrick>();
     b->key = key;
-    const VoxelType type = source_->volume().type;
-    b->voxels.resize(source_->hierarchy().layout().padded_voxels() * voxel_size(type));
-    source_->read_brick(key, b->voxels);
+    b->timepoint = t;
+    const VoxelType type = source.volume().type;
+    b->voxels.resize(source.hierarchy().layout().padded_voxels() * voxel_size(type));
+    source.read_brick(key, b->voxels);
     b->meta = scan_brick(b->voxels, type);
     // A constant brick needs no cache slot, so its voxels are dead weight on the host.
     if (b->meta.constant) std::vector<std::byte>().swap(b->voxels);
@@ -184,31 +229,42 @@ std::shared_ptr<const HostBrick> BrickLoader::read_brick(BrickKey key, std::stri
     // Any exception (also bad_alloc) marks the brick failed: retrying would fail again and
     // block convergence, and the worker thread must survive it.
     const glm::uvec3 c = key.brick();
-    failure = source_->name() + ": brick level " + std::to_string(key.level()) + " channel " +
-              std::to_string(key.channel()) + " (" + std::to_string(c.x) + ", " +
+    // The timepoint is named only for a series, so that messages of other data stay as they were.
+    const std::string when =
+        source.timepoints() > 1 ? " timepoint " + std::to_string(t) + "," : std::string();
+    failure = source.name() + ":" + when + " brick level " + std::to_string(key.level()) +
+              " channel " + std::to_string(key.channel()) + " (" + std::to_string(c.x) + ", " +
               std::to_string(c.y) + ", " + std::to_string(c.z) + "): " + e.what();
     return nullptr;
   }
 }
 
-void BrickLoader::prefetch_one(BrickKey key) {
+void BrickLoader::prefetch_one(const TimedBrickKey& key) {
   std::string failure;
-  std::shared_ptr<const HostBrick> result = read_brick(key, failure);
+  std::shared_ptr<const HostBrick> result;
+  try {
+    const std::shared_ptr<const BrickSource> source = sources_->at(key.timepoint);
+    result = read_brick(*source, key.key, key.timepoint, failure);
+  } catch (const std::exception& e) {
+    failure = sources_->series()->name() + ": timepoint " + std::to_string(key.timepoint) + ": " +
+              e.what();
+  }
   {
     std::lock_guard lock(mutex_);
     prefetching_.erase(key);
-    const auto adopted = adopted_.find(key);
+    // Adoptions belong to the current timepoint (set_timepoint() clears them).
+    const auto adopted = key.timepoint == timepoint_ ? adopted_.find(key.key) : adopted_.end();
     if (result) {
       if (adopted != adopted_.end()) {
         const LoadRequest& r = adopted->second;
-        ready_[key] = LoadedBrick{result, r.hits, r.since, r.rank};
+        ready_[key.key] = LoadedBrick{result, r.hits, r.since, r.rank};
         ++stats_.prefetch_hits;
       } else {
         prefetched_.insert(key);
       }
       ++stats_.prefetched;
-    } else if (failed_.insert(key).second) {
-      new_failures_.push_back(LoadFailure{key, std::move(failure)});
+    } else if (key.timepoint == timepoint_ && failed_.insert(key.key).second) {
+      new_failures_.push_back(LoadFailure{key.key, std::move(failure)});
       ++stats_.failures;
     }
     if (adopted != adopted_.end()) adopted_.erase(adopted);
@@ -216,16 +272,27 @@ void BrickLoader::prefetch_one(BrickKey key) {
   idle_cv_.notify_all();
 }
 
-void BrickLoader::load_one(const LoadRequest& r) {
-  std::shared_ptr<const HostBrick> result = cache_.get(r.key);
+void BrickLoader::load_one(const Job& job) {
+  const LoadRequest& r = job.request;
+  std::shared_ptr<const HostBrick> result = cache_.get(r.key, job.timepoint);
   const bool from_cache = result != nullptr;
   std::string failure;
-  if (!result) result = read_brick(r.key, failure);
+  if (!result) result = read_brick(*job.source, r.key, job.timepoint, failure);
   {
     std::lock_guard lock(mutex_);
+    if (job.generation != generation_) {
+      // The timepoint changed while this brick loaded: delivering it would show voxels of
+      // the old timepoint in a frame of the new one.
+      --stale_in_flight_;
+      ++stats_.stale_dropped;
+      idle_cv_.notify_all();
+      return;
+    }
     in_flight_.erase(r.key);
     // Counted once: a prefetched brick served from the cache, or read again after its eviction.
-    if (prefetched_.erase(r.key) && from_cache) ++stats_.prefetch_hits;
+    if (prefetched_.erase(TimedBrickKey{r.key, job.timepoint}) && from_cache) {
+      ++stats_.prefetch_hits;
+    }
     if (result) {
       ready_[r.key] = LoadedBrick{result, r.hits, r.since, r.rank};
       ++(from_cache ? stats_.host_hits : stats_.loads);
@@ -241,7 +308,8 @@ void BrickLoader::wait_idle() {
   std::unique_lock lock(mutex_);
   if (workers_.empty()) return;  // nothing runs in the background
   idle_cv_.wait(lock, [this] {
-    return queue_.empty() && in_flight_.empty() && prefetch_.empty() && prefetching_.empty();
+    return queue_.empty() && in_flight_.empty() && prefetch_.empty() && prefetching_.empty() &&
+           stale_in_flight_ == 0;
   });
 }
 

@@ -66,4 +66,29 @@ void BrickSource::check_brick_request(BrickKey key, std::span<const std::byte> o
   }
 }
 
+std::shared_ptr<const BrickSource> BrickSource::open_timepoint(std::uint32_t t) const {
+  throw invalid_parameter("timepoint", std::to_string(t) + " but " + name() + " has " +
+                                           std::to_string(timepoints()) + " timepoint(s)");
+}
+
+std::shared_ptr<const BrickSource> source_at_timepoint(std::shared_ptr<const BrickSource> source,
+                                                       std::uint32_t t) {
+  if (!source) throw invalid_parameter("source", "must not be null");
+  const std::uint32_t n = source->timepoints();
+  if (t >= n) {
+    throw invalid_parameter("timepoint", std::to_string(t) + " but " + source->name() + " has " +
+                                             std::to_string(n) + " timepoint(s) (0.." +
+                                             std::to_string(n - 1) + ")");
+  }
+  if (t == source->timepoint()) return source;
+  std::shared_ptr<const BrickSource> other = source->open_timepoint(t);
+  if (!other || other->timepoint() != t || !(other->hierarchy() == source->hierarchy())) {
+    throw Error(ErrorCode::corrupt, source->name() + ": timepoint " + std::to_string(t) +
+                                        " has another volume description or brick layout than "
+                                        "timepoint " +
+                                        std::to_string(source->timepoint()));
+  }
+  return other;
+}
+
 }  // namespace resoct

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -29,8 +31,12 @@ struct ZarrImage {
   OmeMultiscales ms;
   std::vector<ZarrDataset> datasets;
   std::uint64_t timepoint = 0;
+  std::uint64_t timepoints = 1;  // extent of the t axis (1 without one)
+  // Decoded chunks of this timepoint (keys have no room for t); each timepoint has its own.
   std::unique_ptr<HostBrickCache> chunks;
-  std::unique_ptr<ZarrShardReader> shards;  // v3 shard indexes (LRU) and inner-chunk reads
+  std::uint64_t chunk_cache_bytes = 0;
+  // v3 shard indexes (LRU) and inner-chunk reads; keyed by store key, so shared by timepoints.
+  std::shared_ptr<ZarrShardReader> shards;
   VoxelType type = VoxelType::u8;
   DataType data_type = DataType::u8;
   std::string group_key;  // ".zattrs" (v2) or "zarr.json" (v3): names the image in messages
@@ -252,7 +258,8 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
   img->store = std::move(store);
   img->timepoint = o.timepoint;
   img->chunks = std::make_unique<HostBrickCache>(o.chunk_cache_bytes);
-  img->shards = std::make_unique<detail::ZarrShardReader>(img->store, kShardIndexCacheBytes);
+  img->chunk_cache_bytes = o.chunk_cache_bytes;
+  img->shards = std::make_shared<detail::ZarrShardReader>(img->store, kShardIndexCacheBytes);
   img->group_key = ".zattrs";
   bool multiscales = false;
   // Zarr v3 (OME-Zarr 0.5): one zarr.json per node; a group with attributes.ome, or an array.
@@ -314,6 +321,7 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
                                              std::to_string(d0.meta.shape[std::size_t(d0.t)]) +
                                              " timepoints");
   }
+  if (d0.t >= 0) img->timepoints = d0.meta.shape[std::size_t(d0.t)];
   if (d0.t < 0 && o.timepoint != 0) {
     throw invalid_parameter("timepoint", "the image has no t axis");
   }
@@ -323,6 +331,23 @@ std::shared_ptr<ZarrImage> load_image(std::shared_ptr<const ByteStore> store,
                                             " channels (at most 256)");
   }
   return img;
+}
+
+/// The same image at another timepoint: metadata and shard indexes shared, chunk cache its own.
+std::shared_ptr<ZarrImage> image_at(const ZarrImage& img, std::uint64_t t) {
+  auto other = std::make_shared<ZarrImage>();
+  other->store = img.store;
+  other->ms = img.ms;
+  other->datasets = img.datasets;
+  other->timepoint = t;
+  other->timepoints = img.timepoints;
+  other->chunks = std::make_unique<HostBrickCache>(img.chunk_cache_bytes);
+  other->chunk_cache_bytes = img.chunk_cache_bytes;
+  other->shards = img.shards;
+  other->type = img.type;
+  other->data_type = img.data_type;
+  other->group_key = img.group_key;
+  return other;
 }
 
 /// The hierarchy level a coarser dataset can serve, or -1.
@@ -347,13 +372,62 @@ int matching_level(const BrickHierarchy& h, const ZarrImage& img, std::size_t k)
 
 }  // namespace
 
+/// The source over `img`: stored datasets serve the levels they match, the rest is computed.
+static std::unique_ptr<OmeZarrSource> make_zarr_source(std::shared_ptr<const ZarrImage> img,
+                                                       const VolumeDesc& desc,
+                                                       const BrickLayout& layout,
+                                                       const PyramidSourceOptions& po,
+                                                       std::string name) {
+  const BrickHierarchy h(desc, layout);
+  std::vector<LevelBoxReader> levels(h.level_count());
+  std::vector<int> level_dataset(h.level_count(), -1);
+  auto reader = [img](std::size_t k) {
+    return [img, k](std::uint32_t c, const Box3& box, std::span<std::byte> out) {
+      read_box(*img, k, c, box, out);
+    };
+  };
+  levels[0] = reader(0);
+  level_dataset[0] = 0;
+  for (std::size_t k = 1; k < img->datasets.size(); ++k) {
+    const int l = matching_level(h, *img, k);
+    if (l > 0 && level_dataset[std::size_t(l)] < 0) {
+      levels[std::size_t(l)] = reader(k);
+      level_dataset[std::size_t(l)] = int(k);
+    }
+  }
+  return std::make_unique<OmeZarrSource>(img, desc, layout, std::move(levels), std::move(name), po,
+                                         std::move(level_dataset));
+}
+
 OmeZarrSource::OmeZarrSource(std::shared_ptr<const detail::ZarrImage> image, VolumeDesc desc,
                              BrickLayout layout, std::vector<LevelBoxReader> levels,
                              std::string name, PyramidSourceOptions options,
                              std::vector<int> level_dataset)
     : PyramidSource(std::move(desc), layout, std::move(levels), std::move(name), options),
       image_(std::move(image)),
-      level_dataset_(std::move(level_dataset)) {}
+      level_dataset_(std::move(level_dataset)),
+      options_(options) {}
+
+std::uint32_t OmeZarrSource::timepoints() const {
+  return std::uint32_t(std::min<std::uint64_t>(image_->timepoints, UINT32_MAX));
+}
+
+std::uint32_t OmeZarrSource::timepoint() const {
+  return std::uint32_t(image_->timepoint);
+}
+
+std::shared_ptr<const BrickSource> OmeZarrSource::open_timepoint(std::uint32_t t) const {
+  if (t >= timepoints()) {
+    throw invalid_parameter("timepoint", std::to_string(t) + " but the image has " +
+                                             std::to_string(timepoints()) + " timepoints");
+  }
+  // The series keeps the value ranges it was opened with (omero windows, or the data range of
+  // the timepoint opened first), so one transfer function maps every timepoint alike.
+  PyramidSourceOptions po = options_;
+  po.ranges_from_data = false;
+  return make_zarr_source(image_at(*image_, t), hierarchy().volume(), hierarchy().layout(), po,
+                          name());
+}
 
 const OmeMultiscales& OmeZarrSource::multiscales() const noexcept {
   return image_->ms;
@@ -409,25 +483,7 @@ std::unique_ptr<OmeZarrSource> open_ome_zarr(std::shared_ptr<const ByteStore> st
   }
   std::string name = img->store->location(img->group_key);
   name.resize(name.size() - img->group_key.size() - 1);
-  const BrickHierarchy h(desc, layout);
-  std::vector<LevelBoxReader> levels(h.level_count());
-  std::vector<int> level_dataset(h.level_count(), -1);
-  auto reader = [img](std::size_t k) {
-    return [img, k](std::uint32_t c, const Box3& box, std::span<std::byte> out) {
-      read_box(*img, k, c, box, out);
-    };
-  };
-  levels[0] = reader(0);
-  level_dataset[0] = 0;
-  for (std::size_t k = 1; k < img->datasets.size(); ++k) {
-    const int l = matching_level(h, *img, k);
-    if (l > 0 && level_dataset[std::size_t(l)] < 0) {
-      levels[std::size_t(l)] = reader(k);
-      level_dataset[std::size_t(l)] = int(k);
-    }
-  }
-  return std::make_unique<OmeZarrSource>(img, desc, layout, std::move(levels), std::move(name), po,
-                                         std::move(level_dataset));
+  return make_zarr_source(img, desc, layout, po, std::move(name));
 }
 
 std::unique_ptr<OmeZarrSource> open_ome_zarr(const std::string& directory,

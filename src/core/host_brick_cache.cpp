@@ -65,16 +65,16 @@ std::uint32_t HostBrickCache::take_slot() {
 void HostBrickCache::remove_slot(std::uint32_t slot) {
   Entry& e = entries_[slot];
   bytes_ -= cost(*e.brick);
-  index_.erase(e.brick->key);
+  index_.erase(TimedBrickKey{e.brick->key, e.brick->timepoint});
   policy_->on_remove(slot);
   e = Entry{};
   pins_[slot] = CacheSlot{};
   free_.push_back(slot);
 }
 
-std::shared_ptr<const HostBrick> HostBrickCache::get(BrickKey key) {
+std::shared_ptr<const HostBrick> HostBrickCache::get(BrickKey key, std::uint32_t timepoint) {
   std::lock_guard lock(mutex_);
-  auto it = index_.find(key);
+  auto it = index_.find(TimedBrickKey{key, timepoint});
   if (it == index_.end()) {
     ++stats_.misses;
     return nullptr;
@@ -85,9 +85,9 @@ std::shared_ptr<const HostBrick> HostBrickCache::get(BrickKey key) {
   return entries_[it->second].brick;
 }
 
-bool HostBrickCache::contains(BrickKey key) const {
+bool HostBrickCache::contains(BrickKey key, std::uint32_t timepoint) const {
   std::lock_guard lock(mutex_);
-  return index_.count(key) != 0;
+  return index_.count(TimedBrickKey{key, timepoint}) != 0;
 }
 
 void HostBrickCache::put(std::shared_ptr<const HostBrick> brick) {
@@ -96,12 +96,13 @@ void HostBrickCache::put(std::shared_ptr<const HostBrick> brick) {
   std::lock_guard lock(mutex_);
   // A brick that cannot fit would evict everything and then itself; keep the cache instead.
   if (c > capacity_) return;
-  auto it = index_.find(brick->key);
+  const TimedBrickKey timed{brick->key, brick->timepoint};
+  auto it = index_.find(timed);
   if (it != index_.end()) remove_slot(it->second);
   const std::uint32_t slot = take_slot();
   const BrickKey key = brick->key;
   entries_[slot].brick = std::move(brick);
-  index_.emplace(key, slot);
+  index_.emplace(timed, slot);
   bytes_ += c;
   record_use(slot);
   policy_->on_insert(slot, key, frame_);

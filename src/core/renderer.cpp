@@ -113,7 +113,8 @@ void RendererOptions::validate() const {
   if (prefetch.lookahead_frames > 64) {
     throw invalid_parameter("prefetch.lookahead_frames", "must be at most 64");
   }
-  if (prefetch.lookahead_frames > 0 && (prefetch.max_bricks == 0 || prefetch.max_bytes == 0)) {
+  if ((prefetch.lookahead_frames > 0 || prefetch.next_timepoint) &&
+      (prefetch.max_bricks == 0 || prefetch.max_bytes == 0)) {
     throw invalid_parameter("prefetch", "max_bricks and max_bytes must be > 0 when enabled");
   }
   if (loader_threads > 1024) throw invalid_parameter("loader_threads", "must be at most 1024");
@@ -148,6 +149,8 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
   loader_ = std::make_unique<BrickLoader>(
       source_, options_.loader_threads, options_.host_cache_bytes,
       make_host_policy(options_.host_eviction, hierarchy_, host_camera_));
+  timepoint_ = source_->timepoint();
+  timepoint_source_ = source_;
   backend_ = create_backend(options_.backend, options_.backend_options);
   config_.voxel_type = hierarchy_.volume().type;
   config_.padded_brick = hierarchy_.layout().padded_size();
@@ -209,6 +212,33 @@ void Renderer::assign_channels(const Scene& scene) {
     for (std::uint32_t cs : remap.released_cache_slots) cache_->release(cs);
     octree_->remap_slot(slot, hierarchy_.volume().range(missing[i]));
   }
+}
+
+void Renderer::switch_timepoint(std::uint32_t t) {
+  // Opened first: if opening fails nothing has changed yet.
+  std::shared_ptr<const BrickSource> next = loader_->timepoint_sources().at(t);
+  loader_->set_timepoint(t);
+  timepoint_ = t;
+  timepoint_source_ = std::move(next);
+  // Everything on the device and in the octree describes the old timepoint's voxels: page
+  // entries (MAPPED, and EMPTY / HOMOGENEOUS values), residency and node metadata (value ranges
+  // and occupancy that empty-space skipping trusts). Reassigning every slot to its channel is
+  // the remap path a channel change takes: it clears the slot's page tables, releases its cache
+  // slots and starts a new epoch, and remap_slot forgets the slot's node metadata, which the
+  // device then requests again and answer_nodes() takes from the new timepoint's source.
+  for (std::uint32_t s = 0; s < channels_.slot_count(); ++s) {
+    const auto ch = channels_.channel(s);
+    if (!ch) continue;
+    for (const std::optional<std::uint32_t> c : {std::optional<std::uint32_t>(), ch}) {
+      const SlotRemap remap = channels_.assign(s, c, pages_);
+      for (std::uint32_t cs : remap.released_cache_slots) cache_->release(cs);
+    }
+    octree_->remap_slot(s, hierarchy_.volume().range(*ch));
+  }
+  // Loaded or requested for the old timepoint: never applied.
+  staged_.clear();
+  waiting_since_.clear();
+  pending_nodes_.clear();
 }
 
 void Renderer::evict(BrickKey key) {
@@ -276,7 +306,9 @@ void Renderer::apply_loaded(FrameStats& stats) {
   std::vector<const LoadedBrick*> candidate_bricks;
   for (const LoadedBrick& b : all) {
     const auto addr = channels_.address_of(b.brick->key);
-    if (!addr || !page_unmapped(pages_.entry(*addr))) {
+    // The loader delivers only the current timepoint (it drops stale loads); checked here too
+    // because a brick of another timepoint must never reach the image.
+    if (!addr || !page_unmapped(pages_.entry(*addr)) || b.brick->timepoint != timepoint_) {
       ++stats.stale_loads;  // channel left the visible slots, or mapped meanwhile
       continue;
     }
@@ -311,7 +343,7 @@ void Renderer::answer_nodes(FrameStats& stats) {
       const auto ch = channels_.channel(s);
       if (!ch) continue;
       if (answered >= options_.max_node_answers) break;
-      octree_->node_metadata(s, node, source_->region_meta(*ch, box));
+      octree_->node_metadata(s, node, timepoint_source_->region_meta(*ch, box));
       ++answered;
     }
     if (answered >= options_.max_node_answers) break;
@@ -406,10 +438,26 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
   return outstanding || !pending_nodes_.empty() || result.stats.requests_dropped != 0;
 }
 
+void Renderer::prefetch_next_timepoint(const Scene& scene, std::size_t max,
+                                       std::vector<TimedBrickKey>& keys) {
+  const std::uint32_t next = (timepoint_ + 1) % timepoints();
+  if (next == timepoint_) return;
+  // Only what would still have to be read. The device holds nothing of another timepoint, so
+  // the host cache (and earlier failures, which the loader reports) decide alone.
+  const auto want = [&](BrickKey k) { return !loader_->host_cache().contains(k, next); };
+  try {
+    for (const BrickKey k : view_bricks(hierarchy_, scene, max, want)) {
+      keys.push_back(TimedBrickKey{k, next});
+    }
+  } catch (const Error&) {
+    // A camera view_bricks cannot enumerate renders nothing either: nothing to prefetch.
+  }
+}
+
 void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
   predictor_.observe(scene.camera);
   const PrefetchOptions& po = options_.prefetch;
-  if (po.lookahead_frames == 0) return;
+  if (po.lookahead_frames == 0 && !po.next_timepoint) return;
   const std::vector<Camera> poses = predictor_.predict(po.lookahead_frames);
   const std::uint64_t brick_bytes =
       hierarchy_.layout().padded_voxels() * voxel_size(hierarchy_.volume().type);
@@ -421,7 +469,7 @@ void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
   const auto want = [&](BrickKey k) {
     const auto addr = channels_.address_of(k);
     if (!addr || !page_unmapped(pages_.entry(*addr))) return false;
-    if (loader_->has_failed(k) || loader_->host_cache().contains(k)) return false;
+    if (loader_->has_failed(k) || loader_->host_cache().contains(k, timepoint_)) return false;
     return seen.insert(k).second;
   };
   Scene predicted = scene;
@@ -436,10 +484,15 @@ void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
       break;  // the extrapolated camera degenerated (eye on target, up along the view)
     }
   }
+  std::vector<TimedBrickKey> timed;
+  for (const BrickKey k : keys) timed.push_back(TimedBrickKey{k, timepoint_});
+  // The next timepoint's bricks come after the current one's: they matter only after a switch.
+  if (po.next_timepoint) prefetch_next_timepoint(scene, max, timed);
+  stats.prefetch_next_timepoint = timed.size() - keys.size();
   // Replaces the previous frame's prefetches: the prediction moved on.
-  loader_->prefetch(keys);
-  if (loader_->thread_count() == 0) loader_->run_prefetch(keys.size());
-  stats.prefetch_queued = keys.size();
+  loader_->prefetch(std::span<const TimedBrickKey>(timed));
+  if (loader_->thread_count() == 0) loader_->run_prefetch(timed.size());
+  stats.prefetch_queued = timed.size();
 }
 
 void Renderer::report_failures(FrameReport& report) {
@@ -464,7 +517,7 @@ const FrameTables& Renderer::frame_tables(const Scene& scene) {
 
 FrameReport Renderer::render_frame(const Scene& scene) {
   const auto t_frame = Clock::now();
-  scene.validate(hierarchy_.volume(), "scene");
+  scene.validate(hierarchy_.volume(), timepoints(), "scene");
   if (scene.channels.size() > channels_.slot_count()) {
     throw invalid_parameter("scene", std::to_string(scene.channels.size()) +
                                          " channels exceed the renderer's " +
@@ -485,6 +538,12 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   stats.frame_index = frame_;
 
   auto t = Clock::now();
+  if (const std::uint32_t wanted = scene.timepoint.value_or(source_->timepoint());
+      wanted != timepoint_) {
+    switch_timepoint(wanted);
+    stats.timepoint_switched = true;
+  }
+  stats.timepoint = timepoint_;
   assign_channels(scene);
   for (std::uint32_t d : pending_blocks_) pages_.allocate_block(d);
   pending_blocks_.clear();

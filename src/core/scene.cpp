@@ -444,6 +444,17 @@ void Scene::validate(const VolumeDesc& volume, const std::string& what) const {
   }
 }
 
+void Scene::validate(const VolumeDesc& volume, std::uint32_t timepoints,
+                     const std::string& what) const {
+  validate(volume, what);
+  if (timepoint && *timepoint >= timepoints) {
+    throw Error(ErrorCode::invalid_argument,
+                what + ": timepoint: " + std::to_string(*timepoint) + " but the volume has " +
+                    std::to_string(timepoints) + " timepoint" + (timepoints == 1 ? "" : "s") +
+                    " (0.." + std::to_string(timepoints == 0 ? 0 : timepoints - 1) + ")");
+  }
+}
+
 Scene parse_scene(std::string_view json_text, const std::string& name) {
   json doc;
   try {
@@ -457,10 +468,10 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   }
   const Reader r(name);
   if (!doc.is_object()) r.fail("(root)", "must be an object");
-  r.only_keys(
-      doc, "",
-      {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity", "background",
-       "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor", "preintegration"});
+  r.only_keys(doc, "",
+              {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity",
+               "background", "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor",
+               "preintegration", "timepoint"});
   Scene s;
   s.camera = read_camera(r, r.require(doc, "", "camera"));
   if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
@@ -489,6 +500,13 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   if (const json* v = r.find(doc, "preintegration")) {
     if (!v->is_boolean()) r.fail("preintegration", "must be true or false");
     s.preintegration = v->get<bool>();
+  }
+  if (const json* v = r.find(doc, "timepoint")) {
+    const std::int64_t t = r.integer(*v, "timepoint");
+    if (t < 0 || t > std::int64_t(UINT32_MAX)) {
+      r.fail("timepoint", std::to_string(t) + " is not in 0.." + std::to_string(UINT32_MAX));
+    }
+    s.timepoint = std::uint32_t(t);
   }
   detail::read_slices_and_lens(doc, name, s);
   read_effect_options(r, doc, s);
@@ -539,6 +557,7 @@ std::string scene_to_json(const Scene& s) {
   doc["effects"] = effects;
   // Written only when on, so that documents of scenes without it are unchanged.
   if (s.preintegration) doc["preintegration"] = true;
+  if (s.timepoint) doc["timepoint"] = *s.timepoint;  // likewise, only when given
   detail::slices_and_lens_to_json(s, doc);
   effects_to_json(s, doc);
   return doc.dump(2) + "\n";

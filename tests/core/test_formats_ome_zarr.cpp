@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -299,3 +300,48 @@ TEST(OmeZarr, RangesFromDataWithoutOmero) {
 }
 
 }  // namespace
+
+TEST(OmeZarr, EveryTimepointOfASeriesOpenedAtTheFirstReadsThatTimepoint) {
+  ASSERT_FALSE(data_dir().empty());
+  // A series opened at timepoint 0 reports the t extent and opens each other timepoint itself
+  // (shared metadata, own chunk cache and region metadata): bricks of every level and region
+  // metadata must be those of that timepoint's voxels. A dozen cases keep the test fast.
+  const BrickLayout layout{glm::uvec3(4), 1};
+  std::size_t series = 0;
+  for (const auto& c : manifest()["cases"]) {
+    const std::string name = c["name"];
+    const std::string axes = c["axes"];
+    if (axes.find('t') == std::string::npos || name.starts_with("pyramid") ||
+        name.starts_with("fill") || name.starts_with("typed") || name == "omero")
+      continue;
+    if (++series > 12) break;
+    SCOPED_TRACE(name);
+    const std::uint64_t times = c["shape"][axes.find('t')];
+    OmeZarrOptions o;
+    o.pyramid.threads = 1;
+    const std::shared_ptr<const BrickSource> first =
+        open_ome_zarr(data_dir() + "/" + name + ".zarr", layout, o);
+    ASSERT_EQ(first->timepoints(), times);
+    EXPECT_EQ(first->timepoint(), 0u);
+    for (std::uint32_t t = 0; t < times; ++t) {
+      const auto at = source_at_timepoint(first, t);
+      EXPECT_EQ(at->timepoint(), t);
+      EXPECT_EQ(at->hierarchy(), first->hierarchy());  // value ranges kept for the series
+      const InMemorySource ref = reference(c, *at, t, layout);
+      test::expect_same_bricks(ref, *at);
+      const Box3 all{glm::i64vec3(0), glm::i64vec3(at->volume().extent)};
+      for (std::uint32_t ch = 0; ch < at->volume().channels; ++ch) {
+        const RegionMeta want = ref.region_meta(ch, all), got = at->region_meta(ch, all);
+        EXPECT_LE(got.min, want.min) << "t " << t << " c " << ch;
+        EXPECT_GE(got.max, want.max) << "t " << t << " c " << ch;
+        EXPECT_EQ(got.occupancy & want.occupancy, want.occupancy) << "t " << t << " c " << ch;
+        // Eager metadata of this timepoint, not of timepoint 0: exact extremes.
+        if (!std::isnan(want.min)) {
+          EXPECT_EQ(got.min, want.min) << "t " << t << " c " << ch;
+          EXPECT_EQ(got.max, want.max) << "t " << t << " c " << ch;
+        }
+      }
+    }
+  }
+  EXPECT_GT(series, 0u);
+}

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/test_brick_store_util.hpp"
+#include "support/generated_data.hpp"
 #include "support/tool_process.hpp"
 
 using resoct::test::shell_quote;
@@ -251,6 +252,54 @@ TEST_F(ToolExitCodes, RenderSuccessIs0AndReplacesTheOldOutputs) {
   EXPECT_EQ(r.exit_code, kOk) << r.err;
   EXPECT_NE(slurp(dir_.file("out.png")), kPrevious);
   EXPECT_NE(slurp(dir_.file("stats.json")), kPrevious);
+}
+
+TEST_F(ToolExitCodes, RenderTimepointAndPlayValuesAreChecked) {
+  const std::string t = RESOCT_RENDER;
+  const std::vector<std::string> out = {"out.png", "stats.json"};
+  const std::string ok = "procedural:tubes:32x32x32";  // one timepoint
+  expect_exit(t, "resoct-render", render(ok, " --timepoint 1"), kBadInput,
+              "parameter 'timepoint': 1 but procedural:tubes:32x32x32 has 1 timepoint (0..0)", out);
+  expect_exit(t, "resoct-render", render(ok, " --timepoint -1"), kUsage, "--timepoint", out);
+  expect_exit(t, "resoct-render", render(ok, " --timepoint x"), kUsage, "--timepoint", out);
+  const auto play = [&](const std::string& range) {
+    return "--volume " + ok + " --scene " + shell_quote(scene("tubes")) +
+           " --width 8 --height 8 --frames 1 --threads 0 --out @DIR@/t{t}.png --play " + range;
+  };
+  expect_exit(t, "resoct-render", play("0:1"), kBadInput, "parameter 'play'", out);
+  expect_exit(t, "resoct-render", play("1:0"), kBadInput, "FIRST:LAST", out);
+  expect_exit(t, "resoct-render", play("0"), kBadInput, "FIRST:LAST", out);
+  expect_exit(t, "resoct-render", play("0:0 --timepoint 0"), kUsage, "--play", out);
+  // One image per timepoint needs a pattern.
+  expect_exit(t, "resoct-render", render(ok, " --play 0:0"), kBadInput, "parameter 'out'", out);
+  const ToolRun r =
+      resoct::test::run_tool_process(dir_.path().string(), t, expand(render(ok, " --timepoint 0")));
+  EXPECT_EQ(r.exit_code, kOk) << r.err;
+}
+
+TEST_F(ToolExitCodes, RenderPlaysAnOmeZarrSeriesOneImagePerTimepoint) {
+  const std::string data = resoct::test::python_generated_dir(
+      RESOCT_BINARY_DIR "/test-data", "ome-zarr", RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr.py");
+  ASSERT_FALSE(data.empty());
+  // t = 3 timepoints of 6 x 7 x 8 u8 (tests/data/make_ome_zarr.py).
+  const std::string volume = shell_quote(data + "/blosc-lz4-shuffle_leu1_small_tzyx.zarr");
+  const std::string args = "--volume " + volume + " --scene " + shell_quote(scene("sphere")) +
+                           " --width 16 --height 16 --converge --threads 0 --play 0:2"
+                           " --out @DIR@/t{t}.png --stats @DIR@/play.json";
+  const ToolRun r =
+      resoct::test::run_tool_process(dir_.path().string(), RESOCT_RENDER, expand(args));
+  ASSERT_EQ(r.exit_code, kOk) << r.err;
+  for (const char* f : {"t0.png", "t1.png", "t2.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir_.file(f))) << f;
+  }
+  const std::string stats = slurp(dir_.file("play.json"));
+  EXPECT_NE(stats.find("\"timepoints\": 3"), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"play\""), std::string::npos) << stats;
+  EXPECT_EQ(count_of(stats, "\"converged\": true"), 4u) << stats;  // 3 timepoints + overall
+  expect_exit(RESOCT_RENDER, "resoct-render",
+              "--volume " + volume + " --scene " + shell_quote(scene("sphere")) +
+                  " --frames 1 --threads 0 --timepoint 3 --out @DIR@/out.png",
+              kBadInput, "has 3 timepoints (0..2)", {"out.png"});
 }
 
 }  // namespace

@@ -5,7 +5,11 @@
 /// same reader serves a local directory and HTTP servers.
 ///
 /// Mapping: the spatial axes z, y, x become resoct's z, y, x (an absent one has extent 1), `c`
-/// becomes channels (at most 256), `t` is fixed to one timepoint. Spacing is the finest
+/// becomes channels (at most 256), `t` is the time series: the source reads the timepoint given by
+/// OmeZarrOptions::timepoint, reports the extent of `t` as timepoints(), and open_timepoint(t)
+/// opens another one sharing the metadata and shard indexes (decoded chunks, computed levels and
+/// region metadata are per timepoint; value ranges are the opened timepoint's, kept for all).
+/// Spacing is the finest
 /// dataset's scale. A coarser dataset is used as hierarchy level l when its shape equals level
 /// l's extent and its scale is the finest scale times 2^factor_log2 of that level (relative
 /// tolerance 1e-3); every other level is built on demand from the next finer one
@@ -58,9 +62,19 @@ class OmeZarrSource final : public PyramidSource {
   /// Decoded-chunk cache statistics (hits, misses, evictions).
   HostBrickCacheStats chunk_cache_stats() const;
 
+  /// The extent of the `t` axis (1 without one), capped at 2^32 - 1.
+  std::uint32_t timepoints() const override;
+  std::uint32_t timepoint() const override;
+  /// The image at timepoint t: a new OmeZarrSource over the same store with this source's
+  /// volume description (value ranges included) and options; its chunk cache has the same
+  /// budget. Throws invalid_parameter("timepoint") for t >= timepoints() and what reading the
+  /// new timepoint's level 0 throws when its metadata is scanned eagerly.
+  std::shared_ptr<const BrickSource> open_timepoint(std::uint32_t t) const override;
+
  private:
   std::shared_ptr<const detail::ZarrImage> image_;
   std::vector<int> level_dataset_;
+  PyramidSourceOptions options_;
 };
 
 /// Opens the image group at the root of `store`. Throws Error(bad_magic) when the store has
