@@ -206,11 +206,22 @@ std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayo
   d.type = detail::voxel_type_for(h.datatype, h.scaled());
   if (!h.scaled() && data_type_of(d.type) != h.datatype) d.data_type = h.datatype;
 
+  d.ranges = options.ranges;  // checked against the channel count by VolumeDesc::validate
+
   PyramidSourceOptions o;
-  o.ranges_from_data = true;
+  o.ranges_from_data = options.ranges.empty();
   // The voxels are read (or mapped) whole at open anyway, so the scan adds at most as much
   // again, and data-derived ranges beat a type's default range for float data.
   o.eager_scan_voxels = std::numeric_limits<std::uint64_t>::max();
+  // The series: another timepoint is this file re-read there, with this timepoint's ranges.
+  o.timepoints = std::uint32_t(std::min<std::uint64_t>(timepoints, UINT32_MAX));
+  o.timepoint = std::uint32_t(options.timepoint);
+  o.open_timepoint = [path, layout, options](std::uint32_t t, const BrickSource& self) {
+    NiftiOptions other = options;
+    other.timepoint = t;
+    other.ranges = self.volume().ranges;
+    return std::shared_ptr<const BrickSource>(open_nifti(path, layout, other));
+  };
   if (!data.gzip() && detail::samples_are_voxels(h.datatype, h.endian, h.scaled()) &&
       place.order.identity() && (channels == 1 || timepoints == 1)) {
     // Stored voxels are resoct voxels, in served order and one channel after another: map the
@@ -222,6 +233,7 @@ std::unique_ptr<BrickSource> open_nifti(const std::string& path, const BrickLayo
     r.spacing = d.spacing;
     r.origin = d.origin;
     r.channels = d.channels;
+    r.ranges = d.ranges;  // samples are voxels here: the file's units are stored units
     r.offset = offset_of(0);
     if (data.file().size() < r.offset || data.file().size() - r.offset < volume * channels) {
       throw file_error(ErrorCode::truncated, data.path(), data.file().size(),

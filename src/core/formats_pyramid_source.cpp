@@ -58,7 +58,10 @@ PyramidSource::PyramidSource(VolumeDesc desc, BrickLayout layout,
     : hierarchy_(checked(std::move(desc), levels, options), layout),
       levels_(std::move(levels)),
       name_(std::move(name)),
-      cache_(std::make_unique<HostBrickCache>(options.cache_bytes)) {
+      cache_(std::make_unique<HostBrickCache>(options.cache_bytes)),
+      timepoints_(options.timepoints),
+      timepoint_(options.timepoint),
+      open_timepoint_(std::move(options.open_timepoint)) {
   VolumeDesc d = hierarchy_.volume();
   const std::uint64_t voxels0 = d.voxel_count();
   const bool eager = voxels0 <= options.eager_scan_voxels / d.channels;
@@ -92,6 +95,11 @@ PyramidSource::PyramidSource(VolumeDesc desc, BrickLayout layout,
                                                    options.lazy_query_blocks,
                                                    options.lazy_cache_entries);
   }
+}
+
+std::shared_ptr<const BrickSource> PyramidSource::open_timepoint(std::uint32_t t) const {
+  if (!open_timepoint_) return BrickSource::open_timepoint(t);
+  return open_timepoint_(t, *this);
 }
 
 PyramidSource::~PyramidSource() = default;

@@ -221,6 +221,20 @@ TEST(NiftiTime, FourthDimensionIsTimeAndFifthIsComponents) {
                           "parameter 'timepoint': " + path +
                               ": 3 is out of range: the image "
                               "has 3 timepoint(s)");
+      // The series as the renderer switches through it (BrickSource::open_timepoint): every
+      // timepoint's voxels, with the value ranges of the timepoint opened first, so that one
+      // transfer function maps them alike (source_at_timepoint checks the hierarchies agree).
+      const std::shared_ptr<const BrickSource> first = open_nifti(path, kLayout, NiftiOptions{1});
+      EXPECT_EQ(first->timepoints(), 3u);
+      EXPECT_EQ(first->timepoint(), 1u);
+      for (std::uint32_t t = 0; t < 3; ++t) {
+        const auto at = source_at_timepoint(first, t);
+        EXPECT_EQ(at->timepoint(), t);
+        EXPECT_EQ(at->volume(), first->volume());
+        EXPECT_EQ(level0_values(*at, 0), expected_u8(24, t));
+      }
+      EXPECT_NE(open_nifti(path, kLayout, NiftiOptions{0})->volume().ranges,
+                first->volume().ranges);  // each timepoint alone has its own data range
 
       // dim[5] = 2 components of 3 timepoints: channel c of timepoint t is volume c * 3 + t.
       s.dim = {5, 4, 3, 2, 3, 2};

@@ -218,7 +218,7 @@ TEST(OmeZarrV3, EveryTimepointOfASeriesOpenedAtTheFirstReadsThatTimepoint) {
       const auto at = source_at_timepoint(first, t);
       EXPECT_EQ(at->timepoint(), t);
       EXPECT_EQ(at->hierarchy(), first->hierarchy());  // value ranges kept for the series
-      const InMemorySource ref = reference(c, *at, t, layout);
+      const InMemorySource ref = test::fixture_reference(data_dir(), c, *at, t, layout);
       test::expect_same_bricks(ref, *at);
       const Box3 all{glm::i64vec3(0), glm::i64vec3(at->volume().extent)};
       for (std::uint32_t ch = 0; ch < at->volume().channels; ++ch) {

@@ -29,6 +29,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -109,6 +110,11 @@ struct NiftiOptions {
   /// Which timepoint (index along dim[4]) is served, 0-based. Out of range:
   /// Error(invalid_argument) naming parameter 'timepoint' and the file's count.
   std::uint64_t timepoint = 0;
+  /// Value range of each channel in stored units (VolumeDesc::ranges), one per channel; empty:
+  /// each channel's finite data range of the timepoint opened. The series' other timepoints
+  /// (BrickSource::open_timepoint) are opened with this source's ranges, so that one transfer
+  /// function maps every timepoint alike.
+  std::vector<ValueRange> ranges;
 };
 
 /// Opens a NIfTI / Analyze image as a brick source whose coarser levels are built on demand (see

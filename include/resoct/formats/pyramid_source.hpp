@@ -54,6 +54,14 @@ struct PyramidSourceOptions {
   std::uint64_t lazy_cache_entries = std::uint64_t(1) << 20;
   /// Threads of the level-0 passes; 0 = hardware concurrency.
   std::uint32_t threads = 0;
+  /// A series whose other timepoints are other sources (a 4-D NIfTI re-read at another
+  /// timepoint): how many there are, which one this source reads, and how to open timepoint t
+  /// given this source (whose value ranges the other timepoints must keep, so that one transfer
+  /// function maps the whole series alike: BrickSource::open_timepoint). Empty: one timepoint.
+  std::uint32_t timepoints = 1;
+  std::uint32_t timepoint = 0;
+  std::function<std::shared_ptr<const BrickSource>(std::uint32_t t, const BrickSource& self)>
+      open_timepoint;
 };
 
 /// Thread-safety: immutable after construction apart from the internal cache; every member may
@@ -73,6 +81,9 @@ class PyramidSource : public BrickSource {
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
   std::string name() const override { return name_; }
+  std::uint32_t timepoints() const override { return timepoints_; }
+  std::uint32_t timepoint() const override { return timepoint_; }
+  std::shared_ptr<const BrickSource> open_timepoint(std::uint32_t t) const override;
 
   /// The voxels of `box` (inside level `level`) of one channel, dense, x fastest.
   /// Throws Error(invalid_argument) for a bad level, channel, box or buffer size.
@@ -98,6 +109,10 @@ class PyramidSource : public BrickSource {
   MetadataPyramid pyramid_;
   std::unique_ptr<detail::LazyMetadata> lazy_;
   std::unique_ptr<HostBrickCache> cache_;
+  std::uint32_t timepoints_ = 1;
+  std::uint32_t timepoint_ = 0;
+  std::function<std::shared_ptr<const BrickSource>(std::uint32_t, const BrickSource&)>
+      open_timepoint_;
 };
 
 /// A PyramidSource over voxels held in memory (level 0 only; coarser levels on demand).
