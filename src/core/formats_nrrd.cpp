@@ -6,6 +6,7 @@
 
 #include "confined_path.hpp"
 #include "formats_inflate.hpp"
+#include "formats_placement.hpp"
 #include "formats_samples.hpp"
 #include "resoct/dense_volume.hpp"
 #include "resoct/error.hpp"
@@ -81,9 +82,15 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   std::uint64_t start = attached ? h.header_bytes : 0;
   start = skip_lines(data, start, h.line_skip);
 
+  // With space directions the voxels are served in world order (NIfTI's rule, one for every
+  // format: formats_placement.hpp); without them in index order at origin 0.
+  detail::Placement place;
+  place.spacing = h.spacing;
+  if (h.world_axes) place = detail::place_grid({*h.world_axes, h.world_origin}, h.extent());
   VolumeDesc d;
-  d.extent = h.extent();
-  d.spacing = h.spacing;
+  d.extent = detail::served_extent(place.order, h.extent());
+  d.spacing = place.spacing;
+  d.origin = place.origin;
   d.channels = h.channels();
   const DataType st = h.type;
   d.type = detail::voxel_type_for(st, false);
@@ -127,12 +134,14 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
       }
       offset = data.size() - need;
     }
-    if (h.channel_axis != 0 && detail::samples_are_voxels(st, h.endian, false)) {
+    if (h.channel_axis != 0 && detail::samples_are_voxels(st, h.endian, false) &&
+        place.order.identity()) {
       RawVolumeOptions r;
       r.extent = d.extent;
       r.type = d.type;
       r.endian = h.endian;
       r.spacing = d.spacing;
+      r.origin = d.origin;
       r.channels = d.channels;
       r.offset = offset;
       return make_dense_pyramid_source(open_raw_volume(data.path(), r), layout, name, o);
@@ -149,6 +158,11 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   detail::convert_samples(stored, st, h.endian, false, 1.0, 0.0, voxels);
   if (h.channel_axis == 0 && d.channels > 1) {
     voxels = deinterleave(voxels, d.channels, voxel_size(d.type));
+  }
+  if (!place.order.identity()) {
+    std::vector<std::byte> served(voxels.size());
+    detail::reorder_voxels(voxels, h.extent(), d.channels, voxel_size(d.type), place.order, served);
+    voxels = std::move(served);
   }
   return make_dense_pyramid_source(DenseVolume::from_bytes(d, std::move(voxels)), layout, name, o);
 }

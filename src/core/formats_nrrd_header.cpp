@@ -114,6 +114,26 @@ DataType parse_type(const Parser& p, const Line& l) {
              "' is not supported (int8, uint8, int16, uint16, int32, uint32, float, double are)");
 }
 
+/// "(x,y,z)" (1..3 numbers; missing components 0) as a vector.
+glm::dvec3 vector3(const Parser& p, const Line& l, std::string_view text) {
+  if (text.size() < 2 || text.front() != '(' || text.back() != ')') {
+    p.fail(ErrorCode::corrupt, l, "expected (x,y,z)");
+  }
+  std::string_view inner = text.substr(1, text.size() - 2);
+  glm::dvec3 out(0.0);
+  int n = 0;
+  while (true) {
+    const std::size_t comma = inner.find(',');
+    const auto c = p.number(trim(inner.substr(0, comma)));
+    if (!c) p.fail(ErrorCode::corrupt, l, "vector components must be numbers");
+    if (n >= 3) p.fail(ErrorCode::corrupt, l, "vectors have 1..3 components");
+    out[n++] = *c;
+    if (comma == std::string_view::npos) break;
+    inner = inner.substr(comma + 1);
+  }
+  return out;
+}
+
 bool domain_kind(std::string_view k) {
   return k == "domain" || k == "space" || k == "time" || k == "???" || k == "none";
 }
@@ -185,6 +205,8 @@ NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
   const Line* encoding = nullptr;
   const Line* spacings = nullptr;
   const Line* directions = nullptr;
+  const Line* origin = nullptr;
+  const Line* space = nullptr;
   const Line* kinds = nullptr;
   for (const Line& l : lines) {
     const std::string_view f = l.field;
@@ -200,6 +222,10 @@ NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
       spacings = &l;
     } else if (f == "space directions") {
       directions = &l;
+    } else if (f == "space origin") {
+      origin = &l;
+    } else if (f == "space") {
+      space = &l;
     } else if (f == "kinds") {
       kinds = &l;
     } else if (f == "endian") {
@@ -267,6 +293,7 @@ NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
     for (std::size_t i = 0; i < dim; ++i) non_spatial[i] = !domain_kind(k[i]);
   }
   std::vector<std::optional<double>> lengths(dim);
+  std::vector<glm::dvec3> steps(dim, glm::dvec3(0.0));
   if (directions != nullptr) {
     const auto v = tokens(directions->value);
     if (v.size() != dim) {
@@ -280,20 +307,9 @@ NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
       if (v[i].size() < 2 || v[i].front() != '(' || v[i].back() != ')') {
         p.fail(ErrorCode::corrupt, *directions, "expected (x,y,z) or none");
       }
-      std::string_view inner = v[i].substr(1, v[i].size() - 2);
-      double sum = 0.0;
-      std::size_t n = 0;
-      while (true) {
-        const std::size_t comma = inner.find(',');
-        const auto c = p.number(trim(inner.substr(0, comma)));
-        if (!c) p.fail(ErrorCode::corrupt, *directions, "vector components must be numbers");
-        sum += *c * *c;
-        ++n;
-        if (comma == std::string_view::npos) break;
-        inner = inner.substr(comma + 1);
-      }
-      if (n < 1 || n > 3) p.fail(ErrorCode::corrupt, *directions, "vectors have 1..3 components");
-      lengths[i] = std::sqrt(sum);
+      steps[i] = vector3(p, *directions, v[i]);
+      lengths[i] =
+          std::sqrt(steps[i].x * steps[i].x + steps[i].y * steps[i].y + steps[i].z * steps[i].z);
     }
   }
   if (dim == 4) {
@@ -334,6 +350,27 @@ NrrdHeader parse_nrrd_header(std::string_view text, std::string_view location) {
       s = *lengths[i];
     }
     h.spacing[a++] = s;
+  }
+  // World placement: the spatial axes' steps as columns, in a right-anterior-superior world.
+  if (directions != nullptr) {
+    glm::dvec3 sign(1.0);
+    if (space != nullptr) {
+      const std::string_view s = space->value;
+      if (s == "left-posterior-superior" || s == "LPS" || s == "left-posterior-superior-time") {
+        sign = {-1.0, -1.0, 1.0};
+      } else if (s == "left-anterior-superior" || s == "LAS" ||
+                 s == "left-anterior-superior-time") {
+        sign = {-1.0, 1.0, 1.0};
+      }
+    }
+    glm::dmat3 axes(1.0);
+    int column = 0;
+    for (std::size_t i = 0; i < dim && column < 3; ++i) {
+      if (int(i) == h.channel_axis) continue;
+      axes[column++] = steps[i] * sign;
+    }
+    h.world_axes = axes;
+    if (origin != nullptr) h.world_origin = vector3(p, *origin, trim(origin->value)) * sign;
   }
   try {
     (void)h.data_bytes();

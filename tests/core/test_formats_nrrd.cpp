@@ -132,13 +132,40 @@ TEST(Nrrd, ChannelAxesSpaceDirectionsAndSkips) {
   file.insert(file.end(), data.begin(), data.end());
   test::write_bytes(dir.file("vec.nrrd"), file);
   const auto vec = open_source(dir.file("vec.nrrd"), BrickLayout{glm::uvec3(4), 1});
+  // Served in world order (docs/formats.md "Physical placement"): index i steps world +y,
+  // j world +x, k world -z, so served x = j, y = i, z = 1 - k; spacing the step lengths; the
+  // origin the corner of the served voxel 0 (stored (0, 0, 1), centred at (0, 0, -3)).
   EXPECT_EQ(vec->volume().channels, 3u);
-  EXPECT_EQ(vec->volume().extent, glm::u64vec3(4, 3, 2));
-  EXPECT_EQ(vec->volume().spacing, glm::dvec3(1.5, 2, 3));
+  EXPECT_EQ(vec->volume().extent, glm::u64vec3(3, 4, 2));
+  EXPECT_EQ(vec->volume().spacing, glm::dvec3(2, 1.5, 3));
+  EXPECT_EQ(vec->volume().origin, glm::dvec3(-1.0, -0.75, -4.5));
   for (std::uint32_t c = 0; c < 3; ++c) {
     const auto v = level0_values(*vec, c);
-    for (std::size_t i = 0; i < 24; ++i) ASSERT_EQ(v[i], double(i * 3 + c));
+    for (std::size_t x = 0; x < 3; ++x) {
+      for (std::size_t y = 0; y < 4; ++y) {
+        for (std::size_t z = 0; z < 2; ++z) {
+          const std::size_t stored = y + 4 * (x + 3 * (1 - z));  // i + 4 (j + 3 k)
+          ASSERT_EQ(v[x + 3 * (y + 4 * z)], double(stored * 3 + c)) << x << " " << y << " " << z;
+        }
+      }
+    }
   }
+  // `space origin` places the first voxel's centre; a left-posterior-superior space is served
+  // in right-anterior-superior order (x and y reversed), as NIfTI is.
+  std::vector<std::uint8_t> ramp;
+  for (std::size_t i = 0; i < 8; ++i) ramp.push_back(std::uint8_t(i));
+  auto lps = text_bytes(
+      "NRRD0005\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspace: "
+      "left-posterior-superior\nspace directions: (0.5,0,0) (0,0.5,0) (0,0,2)\nspace origin: "
+      "(10,20,30)\n\n");
+  lps.insert(lps.end(), ramp.begin(), ramp.end());
+  test::write_bytes(dir.file("lps.nrrd"), lps);
+  const auto placed = open_source(dir.file("lps.nrrd"), BrickLayout{glm::uvec3(4), 1});
+  EXPECT_EQ(placed->volume().spacing, glm::dvec3(0.5, 0.5, 2));
+  // RAS centre of stored voxel (1, 1, 0) is (-10.5, -20.5, 30); the corner is half a voxel lower.
+  EXPECT_EQ(placed->volume().origin, glm::dvec3(-10.75, -20.75, 29));
+  EXPECT_EQ(level0_values(*placed, 0),
+            (std::vector<double>{3, 2, 1, 0, 7, 6, 5, 4}));  // x and y reversed, z kept
   // 4-D with the last axis 2 channels one after another; a detached file with line and byte
   // skips before the data.
   std::vector<std::uint8_t> skipped = text_bytes("junk line 1\njunk line 2\nXYZ");

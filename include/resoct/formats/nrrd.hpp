@@ -5,15 +5,20 @@
 /// double, kept through data_mapping() (voxel_type.hpp: int8 / int16 exactly with an offset,
 /// 32-bit integers and double as f32); 1..4 dimensions: up to three spatial axes (x fastest),
 /// plus a channel axis that is either the first (interleaved, kind vector/list/RGB-color/...) or
-/// the last (one volume after another). Spacing from `spacings`, else the lengths of the
-/// `space directions` vectors, else 1. Each channel's value range is its data's finite min/max.
+/// the last (one volume after another). Placement (docs/formats.md "Physical placement"): with
+/// `space directions` the voxels are reordered so that served +x, +y, +z follow world +R, +A, +S
+/// (as NIfTI's), spacing is the step lengths and the origin comes from `space origin`; without
+/// them the index order is served at origin 0 with spacing from `spacings`, else 1. Each
+/// channel's value range is its data's finite min/max.
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include "resoct/brick_source.hpp"
@@ -32,6 +37,13 @@ struct NrrdHeader {
   /// of the last axis, which holds channels.
   int channel_axis = -1;
   glm::dvec3 spacing{1.0};
+  /// From `space directions`: the world step of each spatial axis (columns, stored order x, y, z)
+  /// in a right-anterior-superior world (`space` left-posterior-superior or left-anterior-superior
+  /// is converted by negating the axes it names the other way); nullopt without directions.
+  std::optional<glm::dmat3> world_axes;
+  /// From `space origin`: the world position of the centre of the first voxel (converted like
+  /// world_axes); 0 when absent.
+  glm::dvec3 world_origin{0.0};
   std::string data_file;       ///< detached data file as written ("" = attached)
   std::int64_t byte_skip = 0;  ///< bytes skipped before the data (after line_skip lines)
   std::uint64_t line_skip = 0;
