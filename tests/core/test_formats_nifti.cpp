@@ -13,8 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <zlib.h>
-
 #include "core/test_brick_store_util.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/nifti.hpp"
@@ -22,6 +20,7 @@
 #include "resoct/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
+#include "support/gzip_bytes.hpp"
 #include "support/level0_values.hpp"
 
 using namespace resoct;
@@ -77,20 +76,6 @@ void append(std::vector<std::uint8_t>& b, T v, bool big) {
   for (std::size_t i = 0; i < sizeof(T); ++i) b.push_back(big ? tmp[sizeof(T) - 1 - i] : tmp[i]);
 }
 
-std::vector<std::uint8_t> gzip(const std::vector<std::uint8_t>& in) {
-  z_stream z{};
-  deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-  std::vector<std::uint8_t> out(deflateBound(&z, uLong(in.size())) + 64);
-  z.next_in = const_cast<Bytef*>(in.data());
-  z.avail_in = uInt(in.size());
-  z.next_out = out.data();
-  z.avail_out = uInt(out.size());
-  deflate(&z, Z_FINISH);
-  out.resize(z.total_out);
-  deflateEnd(&z);
-  return out;
-}
-
 // Every datatype resoct reads, kept as data_mapping() says: values come back in the file's
 // units (stored value minus the mapping's offset), and the data range is the data's own signed
 // range, not the stored one. The values are exact in every mapping (|v| < 2^24 for the 32-bit
@@ -141,7 +126,7 @@ TEST(Nifti, EveryDatatypeBothByteOrdersPlainAndGzip) {
           }
         }
         const std::string path = dir.file(gz ? "v.nii.gz" : "v.nii");
-        test::write_bytes(path, gz ? gzip(b) : b);
+        test::write_bytes(path, gz ? test::gzip_bytes(b) : b);
         const auto src = open_source(path, BrickLayout{glm::uvec3(4), 1});
         const VolumeDesc& d = src->volume();
         EXPECT_EQ(d.type, t.stored);
@@ -261,14 +246,14 @@ TEST(Nifti, DamagedHeadersAndFiles) {
   file.resize(file.size() + 59);  // one voxel short of 5x4x3
   test::write_bytes(dir.file("short.nii"), file);
   EXPECT_RESOCT_ERROR(open_nifti(dir.file("short.nii")), ErrorCode::truncated, "short.nii");
-  test::write_bytes(dir.file("short.nii.gz"), gzip(file));
+  test::write_bytes(dir.file("short.nii.gz"), test::gzip_bytes(file));
   EXPECT_RESOCT_ERROR(open_nifti(dir.file("short.nii.gz")), ErrorCode::truncated, "short.nii.gz");
   file.resize(file.size() + 1);
-  auto gz = gzip(file);
+  auto gz = test::gzip_bytes(file);
   gz.resize(gz.size() / 2);
   test::write_bytes(dir.file("cut.nii.gz"), gz);
   EXPECT_RESOCT_ERROR(open_nifti(dir.file("cut.nii.gz")), ErrorCode::truncated, "cut.nii.gz");
-  gz = gzip(file);
+  gz = test::gzip_bytes(file);
   gz[gz.size() / 2] ^= 0xff;
   gz[gz.size() / 2 + 1] ^= 0x55;
   test::write_bytes(dir.file("bad.nii.gz"), gz);

@@ -9,14 +9,13 @@
 #include <string>
 #include <vector>
 
-#include <zlib.h>
-
 #include "core/test_brick_store_util.hpp"
 #include "resoct/error.hpp"
 #include "resoct/formats/nrrd.hpp"
 #include "resoct/formats/pyramid_source.hpp"
 #include "resoct/open_source.hpp"
 #include "support/expect_error.hpp"
+#include "support/gzip_bytes.hpp"
 #include "support/level0_values.hpp"
 
 using namespace resoct;
@@ -26,20 +25,6 @@ namespace {
 
 std::vector<std::uint8_t> text_bytes(const std::string& s) {
   return std::vector<std::uint8_t>(s.begin(), s.end());
-}
-
-std::vector<std::uint8_t> gzip(const std::vector<std::uint8_t>& in) {
-  z_stream z{};
-  deflateInit2(&z, 6, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY);
-  std::vector<std::uint8_t> out(deflateBound(&z, uLong(in.size())) + 64);
-  z.next_in = const_cast<Bytef*>(in.data());
-  z.avail_in = uInt(in.size());
-  z.next_out = out.data();
-  z.avail_out = uInt(out.size());
-  deflate(&z, Z_FINISH);
-  out.resize(z.total_out);
-  deflateEnd(&z);
-  return out;
 }
 
 /// Sample i of the test volume as the NRRD type stores it, appended in the given byte order.
@@ -82,7 +67,7 @@ TEST(Nrrd, TypesEncodingsByteOrdersAttachedAndDetached) {
                        (detached ? " detached" : " attached"));
           std::vector<std::uint8_t> data;
           for (std::size_t i = 0; i < n; ++i) append_sample(data, type, sample_value(type, i), big);
-          if (gz) data = gzip(data);
+          if (gz) data = test::gzip_bytes(data);
           std::string head = "NRRD0004\n# a comment\ntype: " + type +
                              "\ndimension: 3\nsizes: 6 5 4\nencoding: " + (gz ? "gzip" : "raw") +
                              "\nendian: " + (big ? "big" : "little") +
@@ -233,7 +218,7 @@ TEST(Nrrd, MalformedHeadersAndFiles) {
   test::write_bytes(dir.file("short.nrrd"), file);
   EXPECT_RESOCT_ERROR(open_nrrd(dir.file("short.nrrd")), ErrorCode::truncated, "short.nrrd");
   auto gz = text_bytes("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n");
-  auto packed = gzip(std::vector<std::uint8_t>(8, 3));
+  auto packed = test::gzip_bytes(std::vector<std::uint8_t>(8, 3));
   packed.resize(packed.size() - 10);
   gz.insert(gz.end(), packed.begin(), packed.end());
   test::write_bytes(dir.file("cut.nrrd"), gz);
@@ -241,7 +226,7 @@ TEST(Nrrd, MalformedHeadersAndFiles) {
   // A header announcing far more than the stream holds: truncated, without allocating it.
   auto huge = text_bytes(
       "NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 10000\nencoding: gzip\n\n");
-  const auto small = gzip(std::vector<std::uint8_t>(64, 1));
+  const auto small = test::gzip_bytes(std::vector<std::uint8_t>(64, 1));
   huge.insert(huge.end(), small.begin(), small.end());
   test::write_bytes(dir.file("huge.nrrd"), huge);
   EXPECT_RESOCT_ERROR(open_nrrd(dir.file("huge.nrrd")), ErrorCode::truncated, "holds 64 bytes");

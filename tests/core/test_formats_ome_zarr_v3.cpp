@@ -207,32 +207,7 @@ TEST(OmeZarrV3, EveryTimepointOfASeriesOpenedAtTheFirstReadsThatTimepoint) {
     if (axes.find('t') == std::string::npos || c["levels"] != 1) continue;
     if (++series > 12) break;
     SCOPED_TRACE(name);
-    const std::uint64_t times = c["shape"][axes.find('t')];
-    OmeZarrOptions o;
-    o.pyramid.threads = 1;
-    const std::shared_ptr<const BrickSource> first =
-        open_ome_zarr(data_dir() + "/" + name + ".zarr", layout, o);
-    ASSERT_EQ(first->timepoints(), times);
-    EXPECT_EQ(first->timepoint(), 0u);
-    for (std::uint32_t t = 0; t < times; ++t) {
-      const auto at = source_at_timepoint(first, t);
-      EXPECT_EQ(at->timepoint(), t);
-      EXPECT_EQ(at->hierarchy(), first->hierarchy());  // value ranges kept for the series
-      const InMemorySource ref = test::fixture_reference(data_dir(), c, *at, t, layout);
-      test::expect_same_bricks(ref, *at);
-      const Box3 all{glm::i64vec3(0), glm::i64vec3(at->volume().extent)};
-      for (std::uint32_t ch = 0; ch < at->volume().channels; ++ch) {
-        const RegionMeta want = ref.region_meta(ch, all), got = at->region_meta(ch, all);
-        EXPECT_LE(got.min, want.min) << "t " << t << " c " << ch;
-        EXPECT_GE(got.max, want.max) << "t " << t << " c " << ch;
-        EXPECT_EQ(got.occupancy & want.occupancy, want.occupancy) << "t " << t << " c " << ch;
-        // Eager metadata of this timepoint, not of timepoint 0: exact extremes.
-        if (!std::isnan(want.min)) {
-          EXPECT_EQ(got.min, want.min) << "t " << t << " c " << ch;
-          EXPECT_EQ(got.max, want.max) << "t " << t << " c " << ch;
-        }
-      }
-    }
+    test::expect_series_of_fixture(data_dir(), c, layout);
   }
   EXPECT_GT(series, 0u);
 }

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <memory>
 
 #include "resoct/dense_volume.hpp"
+#include "resoct/formats/ome_zarr.hpp"
+#include "support/brick_compare.hpp"
 #include "support/tool_process.hpp"
 
 namespace resoct::test {
@@ -73,6 +77,38 @@ InMemorySource fixture_reference(const std::string& dir, const nlohmann::json& c
     all.insert(all.end(), v.begin(), v.end());
   }
   return InMemorySource(DenseVolume::from_bytes(zarr.volume(), std::move(all)), layout, 16, "ref");
+}
+
+void expect_series_of_fixture(const std::string& dir, const nlohmann::json& c,
+                              const BrickLayout& layout) {
+  const std::string name = c["name"];
+  const std::string axes = c["axes"];
+  const std::uint64_t times = c["shape"][axes.find('t')];
+  OmeZarrOptions o;
+  o.pyramid.threads = 1;
+  const std::shared_ptr<const BrickSource> first =
+      open_ome_zarr(dir + "/" + name + ".zarr", layout, o);
+  ASSERT_EQ(first->timepoints(), times);
+  EXPECT_EQ(first->timepoint(), 0u);
+  for (std::uint32_t t = 0; t < times; ++t) {
+    const auto at = source_at_timepoint(first, t);
+    EXPECT_EQ(at->timepoint(), t);
+    EXPECT_EQ(at->hierarchy(), first->hierarchy());  // value ranges kept for the series
+    const InMemorySource ref = fixture_reference(dir, c, *at, t, layout);
+    expect_same_bricks(ref, *at);
+    const Box3 all{glm::i64vec3(0), glm::i64vec3(at->volume().extent)};
+    for (std::uint32_t ch = 0; ch < at->volume().channels; ++ch) {
+      const RegionMeta want = ref.region_meta(ch, all), got = at->region_meta(ch, all);
+      EXPECT_LE(got.min, want.min) << "t " << t << " c " << ch;
+      EXPECT_GE(got.max, want.max) << "t " << t << " c " << ch;
+      EXPECT_EQ(got.occupancy & want.occupancy, want.occupancy) << "t " << t << " c " << ch;
+      // Eager metadata of this timepoint, not of timepoint 0: exact extremes.
+      if (!std::isnan(want.min)) {
+        EXPECT_EQ(got.min, want.min) << "t " << t << " c " << ch;
+        EXPECT_EQ(got.max, want.max) << "t " << t << " c " << ch;
+      }
+    }
+  }
 }
 
 }  // namespace resoct::test

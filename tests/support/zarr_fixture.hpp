@@ -32,4 +32,12 @@ InMemorySource fixture_reference(const std::string& dir, const nlohmann::json& c
                                  const BrickSource& zarr, std::uint64_t t,
                                  const BrickLayout& layout);
 
+/// Opens manifest case `c` (an image with a `t` axis) at timepoint 0 and checks the series:
+/// timepoints() is the t extent, and every timepoint opened through source_at_timepoint keeps
+/// the series' hierarchy (value ranges included), serves that timepoint's bricks at every level
+/// (fixture_reference) and answers region metadata of that timepoint's voxels (exact extremes,
+/// a superset of the occupancy).
+void expect_series_of_fixture(const std::string& dir, const nlohmann::json& c,
+                              const BrickLayout& layout);
+
 }  // namespace resoct::test
