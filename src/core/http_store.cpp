@@ -4,7 +4,6 @@
 #include <array>
 #include <atomic>
 #include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cstring>
 #include <mutex>
@@ -12,6 +11,7 @@
 
 #include <curl/curl.h>
 
+#include "http_attempt.hpp"
 #include "http_origin.hpp"
 #include "percent_encoding.hpp"
 #include "s3_error_code.hpp"
@@ -20,6 +20,11 @@
 namespace resoct {
 
 namespace {
+
+using detail::Attempt;
+using detail::parse_content_range;
+using detail::parse_u64;
+using detail::transient;
 
 bool starts_with_ci(std::string_view s, std::string_view prefix) {
   if (s.size() < prefix.size()) return false;
@@ -51,20 +56,6 @@ bool prefix_matches(std::string_view prefix, std::string_view key) {
   return key.starts_with(prefix) && (key.size() == prefix.size() || key[prefix.size()] == '/');
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-
-std::optional<std::uint64_t> parse_u64(std::string_view s) {
-  s = trim(s);
-  std::uint64_t v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || s.empty()) return std::nullopt;
-  return v;
-}
-
 void global_init() {
   static std::once_flag once;
   std::call_once(once, [] {
@@ -73,9 +64,6 @@ void global_init() {
     }
   });
 }
-
-/// Bytes of an error answer kept: an S3 <Error> document names its code near the start.
-constexpr std::size_t kErrorBodyBytes = 4096;
 
 /// SHA-256 of the empty body: every request here is a GET or HEAD. S3 requires the payload
 /// hash as an x-amz-content-sha256 header on signed requests, which libcurl 7.88 does not add
@@ -86,180 +74,6 @@ constexpr const char* kEmptyPayloadSha256 =
 bool has_control_character(std::string_view s) {
   return std::any_of(s.begin(), s.end(),
                      [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
-}
-
-/// State of one attempt, shared with libcurl's callbacks.
-struct Attempt {
-  // What the caller wants.
-  bool ranged = false;
-  bool suffix = false;                      // ranged: the last `want` bytes ("bytes=-want")
-  std::uint64_t offset = 0;                 // ranged: first byte wanted
-  std::uint64_t want = 0;                   // ranged: bytes wanted
-  std::uint64_t max_bytes = 0;              // whole object: limit
-  std::span<std::byte> out;                 // ranged: destination
-  std::vector<std::byte>* whole = nullptr;  // whole object: destination
-  // What arrived.
-  long status = 0;
-  std::optional<std::uint64_t> content_length;
-  std::string content_range;
-  std::uint64_t received = 0;  // body bytes of the final response
-  std::uint64_t kept = 0;
-  bool too_large = false;
-  bool complete_early = false;    // a 200 answer to a range request: stopped once `want` arrived
-  bool suffix_refused = false;    // a suffix request answered otherwise than with 206: fall back
-  std::uint64_t object_size = 0;  // suffix: the total from Content-Range
-  std::string bad_answer;         // set when the server's answer contradicts the request
-  std::string error_body;         // the first bytes of an error answer (an S3 <Error> document)
-  std::string error_code;         // an x-amz-error-code header (S3 stores; HEAD answers too)
-
-  bool ok_status() const { return status >= 200 && status < 300; }
-
-  /// The S3 error code of the answer: the header's, else the body's ("" for none).
-  std::string s3_code() const {
-    return error_code.empty() ? detail::s3_error_code(error_body) : error_code;
-  }
-  /// "HTTP 403", with the S3 error code and advice when the answer has one:
-  /// "HTTP 403 SignatureDoesNotMatch: the secret access key is wrong".
-  std::string status_text() const {
-    std::string text = "HTTP " + std::to_string(status);
-    const std::string code = s3_code();
-    if (code.empty()) return text;
-    text += " " + code;
-    const std::string_view advice = detail::s3_error_advice(code);
-    if (!advice.empty()) text += ": " + std::string(advice);
-    return text;
-  }
-};
-
-std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
-  auto& a = *static_cast<Attempt*>(user);
-  const std::size_t len = size * n;
-  std::string_view line(data, len);
-  if (line.starts_with("HTTP/")) {
-    // A new response (after a redirect or "100 Continue"): forget the previous headers.
-    a.content_length.reset();
-    a.content_range.clear();
-    a.error_code.clear();
-    const std::size_t sp = line.find(' ');
-    a.status = 0;
-    if (sp != std::string_view::npos) {
-      std::from_chars(line.data() + sp + 1, line.data() + std::min(len, sp + 4), a.status);
-    }
-    return len;
-  }
-  const std::size_t colon = line.find(':');
-  if (colon == std::string_view::npos) return len;
-  std::string name(line.substr(0, colon));
-  for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-  const std::string_view value = line.substr(colon + 1);
-  if (name == "content-length") {
-    a.content_length = parse_u64(value);
-    // Refuse an oversized object before its first byte arrives.
-    if (!a.ranged && a.ok_status() && a.content_length && *a.content_length > a.max_bytes) {
-      a.too_large = true;
-      return 0;
-    }
-  } else if (name == "content-range") {
-    a.content_range = std::string(trim(value));
-  } else if (name == "x-amz-error-code") {
-    a.error_code = detail::s3_error_code("<Error><Code>" + std::string(trim(value)) + "</Code>");
-  }
-  return len;
-}
-
-/// "bytes FIRST-LAST/TOTAL" of a 206 answer, or nullopt (TOTAL: nullopt when '*').
-struct ContentRange {
-  std::uint64_t first = 0, last = 0;
-  std::optional<std::uint64_t> total;
-};
-std::optional<ContentRange> parse_content_range(std::string_view cr) {
-  if (!cr.starts_with("bytes ")) return std::nullopt;
-  cr.remove_prefix(6);
-  const std::size_t dash = cr.find('-'), slash = cr.find('/');
-  if (dash == std::string_view::npos || slash == std::string_view::npos || dash > slash) {
-    return std::nullopt;
-  }
-  const auto first = parse_u64(cr.substr(0, dash));
-  const auto last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
-  if (!first || !last) return std::nullopt;
-  return ContentRange{*first, *last, parse_u64(cr.substr(slash + 1))};
-}
-
-/// Whether a 206 answer to "bytes=-want" is the object's tail. Some servers misread a suffix
-/// range (s3rver parses "bytes=-132" as bytes 0-132): their answer is a refusal, not data.
-bool answers_suffix(const Attempt& a) {
-  const auto cr = parse_content_range(a.content_range);
-  return cr && cr->total && cr->last + 1 == *cr->total &&
-         cr->first == *cr->total - std::min(a.want, *cr->total);
-}
-
-std::size_t on_body(char* data, std::size_t size, std::size_t n, void* user) {
-  auto& a = *static_cast<Attempt*>(user);
-  const std::size_t len = size * n;
-  const auto* bytes = reinterpret_cast<const std::byte*>(data);
-  const std::uint64_t at = a.received;
-  a.received += len;
-  if (!a.ok_status()) {
-    // An error page: only the status matters, and an S3 error code if the page has one.
-    a.error_body.append(data, std::min<std::size_t>(len, kErrorBodyBytes - a.error_body.size()));
-    return len;
-  }
-  if (!a.ranged) {
-    if (a.received > a.max_bytes) {
-      a.too_large = true;
-      return 0;
-    }
-    a.whole->insert(a.whole->end(), bytes, bytes + len);
-    a.kept = a.received;
-    return len;
-  }
-  if (a.status == 206) {
-    if (a.suffix && at == 0 && !answers_suffix(a)) {
-      a.suffix_refused = true;  // the caller falls back to the size and a first-last range
-      return 0;
-    }
-    if (a.received > a.want) {
-      a.bad_answer = "206 answer longer than the " + std::to_string(a.want) + " bytes requested";
-      return 0;
-    }
-    std::memcpy(a.out.data() + at, bytes, len);
-    a.kept = a.received;
-    return len;
-  }
-  if (a.suffix) {
-    // 200 to a suffix request: the server ignores suffix ranges. Streaming the whole object to
-    // keep its end would cost what the range was meant to save; the caller asks for the size
-    // and then a first-last range instead.
-    a.suffix_refused = true;
-    return 0;
-  }
-  // 200 to a range request: the whole object streams in; keep only [offset, offset + want).
-  const std::uint64_t lo = std::max(at, a.offset);
-  const std::uint64_t hi = std::min<std::uint64_t>(a.received, a.offset + a.want);
-  if (lo < hi) {
-    std::memcpy(a.out.data() + (lo - a.offset), bytes + (lo - at), std::size_t(hi - lo));
-    a.kept += hi - lo;
-  }
-  if (a.kept == a.want) {
-    a.complete_early = true;
-    return 0;  // abort: the rest of the object is not needed
-  }
-  return len;
-}
-
-bool transient(CURLcode c) {
-  switch (c) {
-    case CURLE_OPERATION_TIMEDOUT:
-    case CURLE_COULDNT_CONNECT:
-    case CURLE_RECV_ERROR:
-    case CURLE_SEND_ERROR:
-    case CURLE_GOT_NOTHING:
-    case CURLE_PARTIAL_FILE:
-    case CURLE_HTTP2:
-    case CURLE_HTTP2_STREAM:
-    case CURLE_SSL_CONNECT_ERROR: return true;
-    default: return false;
-  }
 }
 
 enum class Outcome { done, absent, retry, fail, redirect, no_suffix };
@@ -503,9 +317,9 @@ struct HttpStore::Impl {
     }
     curl_easy_setopt(h, CURLOPT_MAXCONNECTS, long(options.max_idle_connections));
     curl_easy_setopt(h, CURLOPT_TCP_KEEPALIVE, 1L);
-    curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, on_header);
+    curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, detail::on_header);
     curl_easy_setopt(h, CURLOPT_HEADERDATA, &a);
-    curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, on_body);
+    curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, detail::on_body);
     curl_easy_setopt(h, CURLOPT_WRITEDATA, &a);
     if (head) curl_easy_setopt(h, CURLOPT_NOBODY, 1L);
     std::string range;
@@ -624,25 +438,15 @@ struct HttpStore::Impl {
 
   static Outcome check_range(const Attempt& a, ErrorCode& code, std::string& why) {
     if (a.status == 206) {
-      // "bytes FIRST-LAST/TOTAL" (TOTAL may be '*').
-      std::string_view cr = a.content_range;
-      std::optional<std::uint64_t> first, last;
-      if (cr.starts_with("bytes ")) {
-        cr.remove_prefix(6);
-        const std::size_t dash = cr.find('-'), slash = cr.find('/');
-        if (dash != std::string_view::npos && slash != std::string_view::npos && dash < slash) {
-          first = parse_u64(cr.substr(0, dash));
-          last = parse_u64(cr.substr(dash + 1, slash - dash - 1));
-        }
-      }
-      if (!first || !last || *first != a.offset || *last < *first ||
-          *last > a.offset + a.want - 1) {
+      const auto cr = parse_content_range(a.content_range);  // TOTAL may be '*'
+      if (!cr || cr->first != a.offset || cr->last < cr->first ||
+          cr->last > a.offset + a.want - 1) {
         code = ErrorCode::io;
         why = "206 answer with Content-Range '" + a.content_range + "' for bytes " +
               std::to_string(a.offset) + "-" + std::to_string(a.offset + a.want - 1);
         return Outcome::fail;
       }
-      if (*last - *first + 1 != a.received || a.received < a.want) {
+      if (cr->last - cr->first + 1 != a.received || a.received < a.want) {
         code = ErrorCode::truncated;
         why = "object ends after " + std::to_string(a.received) + " of " + std::to_string(a.want) +
               " requested bytes";
