@@ -24,16 +24,12 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
+#include "support/loading_bench.hpp"
 #include "resoct/scene.hpp"
 
 using namespace resoct;
 
 namespace {
-
-bool smoke() {
-  const char* s = std::getenv("RESOCT_BENCH_SMOKE");
-  return s && std::string(s) == "1";
-}
 
 /// Adds a fixed latency to every brick read.
 class SlowSource final : public BrickSource {
@@ -55,14 +51,6 @@ class SlowSource final : public BrickSource {
   std::unique_ptr<BrickSource> inner_;
   std::chrono::microseconds latency_;
 };
-
-// examples/scenes/turbulence.json (benchmarks do not know the source directory).
-constexpr const char* kTurbulenceScene = R"({"camera": {"eye": [1.8, 1.1, 1.6],
-  "target": [0.5, 0.5, 0.5], "up": [0, 1, 0], "fov_deg": 40, "projection": "perspective"},
-  "viewport": {"width": 512, "height": 512}, "channels": [{"channel": 0, "tf": [[0.0, 0, 0, 0, 0],
-  [0.35, 0.2, 0.2, 0.8, 0.0], [0.6, 0.9, 0.6, 0.2, 0.03], [1.0, 1.0, 0.2, 0.1, 0.2]],
-  "levels": [0, 15], "importance": 0, "mode": "dvr"}], "step_scale": 1.0, "lod_error_px": 1.0,
-  "ert_opacity": 0.99, "background": [0, 0, 0, 1], "effects": []})";
 
 Camera orbit(const Camera& c, double deg) {
   const double a = glm::radians(deg);
@@ -88,7 +76,7 @@ Camera pose(const Camera& start, int kind, std::uint32_t f, std::uint32_t path) 
 void BM_PrefetchPath(benchmark::State& state) {
   const auto lookahead = std::uint32_t(state.range(0));
   const int kind = int(state.range(1));
-  const bool tiny = smoke();
+  const bool tiny = bench::loading_smoke();
   // The period exceeds the render time of a 32x32 frame even on a loaded machine, so that loading,
   // not rendering, limits progress: one loader thread at 8 ms per brick
   // (RESOCT_PREFETCH_LATENCY_US) reads about 30 bricks a frame, a little more than the orbit needs
@@ -103,7 +91,7 @@ void BM_PrefetchPath(benchmark::State& state) {
                                                  : env_latency ? std::atol(env_latency)
                                                                : 8000);
   cpu::register_backend();
-  Scene scene = parse_scene(kTurbulenceScene, "turbulence");
+  Scene scene = parse_scene(bench::kTurbulenceScene, "turbulence");
   scene.viewport = Viewport{tiny ? 24u : 32u, tiny ? 24u : 32u};
   scene.camera.eye = scene.camera.target + 0.75 * (scene.camera.eye - scene.camera.target);
 

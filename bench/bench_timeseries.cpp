@@ -28,16 +28,12 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
+#include "support/loading_bench.hpp"
 #include "resoct/scene.hpp"
 
 using namespace resoct;
 
 namespace {
-
-bool smoke() {
-  const char* s = std::getenv("RESOCT_BENCH_SMOKE");
-  return s && std::string(s) == "1";
-}
 
 long env_or(const char* name, long fallback) {
   const char* v = std::getenv(name);
@@ -72,17 +68,9 @@ class SlowSeries final : public BrickSource {
   std::chrono::microseconds latency_;
 };
 
-// examples/scenes/turbulence.json (benchmarks do not know the source directory).
-constexpr const char* kTurbulenceScene = R"({"camera": {"eye": [1.8, 1.1, 1.6],
-  "target": [0.5, 0.5, 0.5], "up": [0, 1, 0], "fov_deg": 40, "projection": "perspective"},
-  "viewport": {"width": 512, "height": 512}, "channels": [{"channel": 0, "tf": [[0.0, 0, 0, 0, 0],
-  [0.35, 0.2, 0.2, 0.8, 0.0], [0.6, 0.9, 0.6, 0.2, 0.03], [1.0, 1.0, 0.2, 0.1, 0.2]],
-  "levels": [0, 15], "importance": 0, "mode": "dvr"}], "step_scale": 1.0, "lod_error_px": 1.0,
-  "ert_opacity": 0.99, "background": [0, 0, 0, 1], "effects": []})";
-
 void BM_TimepointSwitch(benchmark::State& state) {
   const bool next = state.range(0) != 0;
-  const bool tiny = smoke();
+  const bool tiny = bench::loading_smoke();
   const std::uint32_t timepoints = tiny ? 2 : 5;
   const auto period =
       std::chrono::milliseconds(tiny ? 1 : env_or("RESOCT_TIMESERIES_PERIOD_MS", 250));
@@ -91,7 +79,7 @@ void BM_TimepointSwitch(benchmark::State& state) {
   const auto hold = std::uint32_t(tiny ? 1 : env_or("RESOCT_TIMESERIES_HOLD", 6));
   constexpr std::uint32_t kMaxFrames = 400;  // per switch: a cap, not reached in practice
   cpu::register_backend();
-  Scene scene = parse_scene(kTurbulenceScene, "turbulence");
+  Scene scene = parse_scene(bench::kTurbulenceScene, "turbulence");
   scene.viewport = Viewport{tiny ? 24u : 32u, tiny ? 24u : 32u};
   scene.camera.eye = scene.camera.target + 0.75 * (scene.camera.eye - scene.camera.target);
 
