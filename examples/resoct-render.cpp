@@ -54,6 +54,7 @@ struct Args {
   std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
   std::string strategy = "greedy";
   std::uint32_t leaf = 16;
+  std::uint32_t retry_failed_ms = 0;
   std::optional<std::uint32_t> timepoint;  // overrides the scene's
   std::string play;                        // "FIRST:LAST": one image per timepoint
   bool no_play_prefetch = false;
@@ -205,6 +206,7 @@ int run(const Args& a) {
   }
   o.device_cache_bytes = a.cache_mb << 20;
   o.loader_threads = a.threads;
+  o.retry_failed_after_ms = a.retry_failed_ms;
   if (a.leaf == 0) throw invalid_parameter("leaf", "must be > 0");
   o.leaf_size = glm::uvec3(a.leaf);
   if (a.frames == 0 && !a.converge)
@@ -357,6 +359,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", a.threads, "loader threads (0 = load synchronously)")
       ->capture_default_str();
   app.add_option("--strategy", a.strategy, "greedy | global")->capture_default_str();
+  app.add_option("--retry-failed-ms", a.retry_failed_ms,
+                 "load a brick that failed with a network or I/O error again after MS "
+                 "(doubling up to 32x; 0 = never)")
+      ->capture_default_str();
   app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
       ->capture_default_str();
   auto* timepoint = app.add_option("--timepoint", a.timepoint,

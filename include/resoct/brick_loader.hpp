@@ -3,6 +3,7 @@
 /// Asynchronous brick loading: a thread pool reads bricks from a BrickSource (through a
 /// HostBrickCache) in priority order and hands decoded bricks to the frame loop.
 
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -64,6 +65,8 @@ struct BrickLoaderStats {
   /// delivered (their bricks stay in the host cache under their own timepoint).
   std::uint64_t stale_dropped = 0;
   std::uint64_t timepoint_switches = 0;  ///< set_timepoint() calls that changed the timepoint
+  /// Failed bricks let through again by the transient-failure retry (set_transient_retry).
+  std::uint64_t retries = 0;
 };
 
 /// Loading order: coarser level first, then lower channel rank, then older (smaller `since`),
@@ -72,7 +75,8 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 
 /// Loads bricks in priority order. request() replaces the set of queued (not yet started)
 /// requests; bricks already in flight finish and are delivered; a key is queued, loading or ready
-/// at most once; a key that failed is never loaded again. prefetch() keeps a second, lower
+/// at most once; a key that failed is not loaded again, unless its failure may pass and
+/// set_transient_retry() allows retries (below). prefetch() keeps a second, lower
 /// priority queue whose bricks go into the host cache only (a worker takes one only while no
 /// request is queued). With 0 threads nothing happens in the background and run_queued() /
 /// run_prefetch() load on the calling thread, which makes tests deterministic.
@@ -130,9 +134,21 @@ class BrickLoader {
 
   /// Loaded bricks not yet taken, in load_before order; the ready list is emptied.
   std::vector<LoadedBrick> take_ready();
-  /// Failures since the last call; each failed key appears exactly once over all calls.
+  /// Failures since the last call; each failed key appears exactly once over all calls, also
+  /// when a retry fails again.
   std::vector<LoadFailure> take_failures();
+  /// True when `key` failed and may not be requested now (a retry that is due is false).
   bool has_failed(BrickKey key) const;
+
+  /// Retries of failures that may pass: an I/O error, a truncated transfer (a network or server
+  /// fault: ErrorCode io or truncated) or exhausted host memory. Such a key is let through again
+  /// `first` after it failed, then after twice as long each time it fails again, up to 32
+  /// times `first`. Corrupt data and other errors are never retried. 0 (the default) never
+  /// retries anything, so a failure is final. Throws Error(invalid_argument) naming
+  /// "retry_after_ms" above one hour.
+  void set_transient_retry(std::chrono::milliseconds first);
+  /// Failed keys that will be let through again (they keep a renderer from converging).
+  std::size_t retries_pending() const;
 
   std::size_t queued() const;
   std::size_t in_flight() const;
@@ -165,9 +181,21 @@ class BrickLoader {
   /// Reads a brick of `source` (timepoint `t`) into the host cache; the failure message when it
   /// throws.
   std::shared_ptr<const HostBrick> read_brick(const BrickSource& source, BrickKey key,
-                                              std::uint32_t t, std::string& failure);
+                                              std::uint32_t t, std::string& failure,
+                                              bool& transient);
   /// Loads one prefetch key without holding mutex_.
   void prefetch_one(const TimedBrickKey& key);
+  /// Files a failure of `key` (current timepoint): marks it failed, schedules its retry when
+  /// `transient` and retries are on, and reports it unless it was reported before. Caller holds
+  /// mutex_.
+  void fail_locked(BrickKey key, std::string failure, bool transient);
+  /// Lets the failed keys whose retry is due through again. Caller holds mutex_.
+  void release_due_retries_locked();
+  /// When a failed key may be loaded again, and how often it failed.
+  struct Retry {
+    std::chrono::steady_clock::time_point due;
+    std::uint32_t attempts = 0;
+  };
 
   std::shared_ptr<TimepointSources> sources_;
   std::shared_ptr<const BrickSource> current_;  // source of timepoint_
@@ -184,7 +212,10 @@ class BrickLoader {
   std::unordered_set<BrickKey> queued_keys_;
   std::unordered_set<BrickKey> in_flight_;
   std::unordered_map<BrickKey, LoadedBrick> ready_;
-  std::unordered_set<BrickKey> failed_;
+  std::unordered_set<BrickKey> failed_;    // not to be loaded (now)
+  std::unordered_set<BrickKey> reported_;  // failures reported, each once
+  std::unordered_map<BrickKey, Retry> retry_;
+  std::chrono::milliseconds retry_first_{0};
   std::deque<TimedBrickKey> prefetch_;  // front loads first
   std::unordered_set<TimedBrickKey> prefetching_;
   std::unordered_set<TimedBrickKey> prefetched_;  // in the host cache by prefetch, not requested

@@ -75,6 +75,12 @@ struct RendererOptions {
   glm::uvec3 leaf_size{16};  ///< residency octree leaf, voxels per axis
   RenderMode mode = RenderMode::residency;
   RequestStrategy strategy = RequestStrategy::greedy;
+  /// Bricks whose load failed with an error that may pass (a network or server fault, exhausted
+  /// host memory) are loaded again this long after the failure, then after twice as long each
+  /// time, up to 32 times (BrickLoader::set_transient_retry); each is still reported once, and a
+  /// frame is not converged while a retry is pending. 0 = a failed brick stays failed (its
+  /// coarser substitute is final). At most 3600000 (one hour).
+  std::uint32_t retry_failed_after_ms = 0;
   /// Loader threads; 0 loads synchronously inside render_frame (deterministic).
   std::uint32_t loader_threads = std::max(1u, std::thread::hardware_concurrency());
   std::uint32_t brick_request_capacity = 1u << 16;
@@ -92,7 +98,8 @@ struct RendererOptions {
 struct FrameReport {
   Image image;
   /// True when the frame needed nothing it did not have: no brick or node requests other than
-  /// for bricks that failed to load, no dropped requests, nothing queued, loading or waiting.
+  /// for bricks that failed to load (for good: no retry pending), no dropped requests, nothing
+  /// queued, loading or waiting.
   bool converged = false;
   FrameStats stats;
   std::vector<LoadFailure> failures;  ///< bricks that failed to load, each reported once

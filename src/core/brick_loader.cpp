@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <new>
 #include <utility>
 
 #include "resoct/error.hpp"
@@ -44,6 +45,7 @@ BrickLoader::~BrickLoader() {
 void BrickLoader::request(std::span<const LoadRequest> wanted) {
   {
     std::lock_guard lock(mutex_);
+    release_due_retries_locked();
     std::unordered_set<BrickKey> next_keys;
     std::vector<LoadRequest> next;
     std::unordered_map<BrickKey, LoadRequest> adopted;
@@ -96,6 +98,8 @@ void BrickLoader::set_timepoint(std::uint32_t t) {
     ready_.clear();
     adopted_.clear();
     failed_.clear();
+    reported_.clear();
+    retry_.clear();
     // Still running: they complete into the host cache but are never delivered.
     stale_in_flight_ += in_flight_.size();
     in_flight_.clear();
@@ -212,7 +216,9 @@ std::size_t BrickLoader::prefetch_queued() const {
 }
 
 std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& source, BrickKey key,
-                                                         std::uint32_t t, std::string& failure) {
+                                                         std::uint32_t t, std::string& failure,
+                                                         bool& transient) {
+  transient = false;
   try {
     auto b = std::make_shared<HostBrick>();
     b->key = key;
@@ -226,8 +232,15 @@ std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& sour
     cache_.put(b);
     return b;
   } catch (const std::exception& e) {
-    // Any exception (also bad_alloc) marks the brick failed: retrying would fail again and
-    // block convergence, and the worker thread must survive it.
+    // Any exception (also bad_alloc) marks the brick failed, and the worker thread must survive
+    // it. Only a failure that may pass is retried (set_transient_retry): corrupt data would fail
+    // again and block convergence.
+    if (const auto* err = dynamic_cast<const Error*>(&e)) {
+      transient = err->code() == ErrorCode::io || err->code() == ErrorCode::truncated ||
+                  err->code() == ErrorCode::out_of_memory;
+    } else {
+      transient = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
+    }
     const glm::uvec3 c = key.brick();
     // The timepoint is named only for a series, so that messages of other data stay as they were.
     const std::string when =
@@ -241,10 +254,11 @@ std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& sour
 
 void BrickLoader::prefetch_one(const TimedBrickKey& key) {
   std::string failure;
+  bool transient = false;
   std::shared_ptr<const HostBrick> result;
   try {
     const std::shared_ptr<const BrickSource> source = sources_->at(key.timepoint);
-    result = read_brick(*source, key.key, key.timepoint, failure);
+    result = read_brick(*source, key.key, key.timepoint, failure, transient);
   } catch (const std::exception& e) {
     failure = sources_->series()->name() + ": timepoint " + std::to_string(key.timepoint) + ": " +
               e.what();
@@ -263,9 +277,9 @@ void BrickLoader::prefetch_one(const TimedBrickKey& key) {
         prefetched_.insert(key);
       }
       ++stats_.prefetched;
-    } else if (key.timepoint == timepoint_ && failed_.insert(key.key).second) {
-      new_failures_.push_back(LoadFailure{key.key, std::move(failure)});
-      ++stats_.failures;
+      if (key.timepoint == timepoint_) retry_.erase(key.key);
+    } else if (key.timepoint == timepoint_) {
+      fail_locked(key.key, std::move(failure), transient);
     }
     if (adopted != adopted_.end()) adopted_.erase(adopted);
   }
@@ -277,7 +291,8 @@ void BrickLoader::load_one(const Job& job) {
   std::shared_ptr<const HostBrick> result = cache_.get(r.key, job.timepoint);
   const bool from_cache = result != nullptr;
   std::string failure;
-  if (!result) result = read_brick(*job.source, r.key, job.timepoint, failure);
+  bool transient = false;
+  if (!result) result = read_brick(*job.source, r.key, job.timepoint, failure, transient);
   {
     std::lock_guard lock(mutex_);
     if (job.generation != generation_) {
@@ -296,12 +311,52 @@ void BrickLoader::load_one(const Job& job) {
     if (result) {
       ready_[r.key] = LoadedBrick{result, r.hits, r.since, r.rank};
       ++(from_cache ? stats_.host_hits : stats_.loads);
-    } else if (failed_.insert(r.key).second) {
-      new_failures_.push_back(LoadFailure{r.key, std::move(failure)});
-      ++stats_.failures;
+      retry_.erase(r.key);
+    } else {
+      fail_locked(r.key, std::move(failure), transient);
     }
   }
   idle_cv_.notify_all();
+}
+
+void BrickLoader::fail_locked(BrickKey key, std::string failure, bool transient) {
+  failed_.insert(key);
+  if (transient && retry_first_.count() > 0) {
+    Retry& r = retry_[key];
+    // first, 2 first, 4 first, ... 32 first: a server that stays down is asked rarely.
+    r.due = std::chrono::steady_clock::now() + retry_first_ * (1u << std::min(r.attempts, 5u));
+    ++r.attempts;
+  } else {
+    retry_.erase(key);
+  }
+  if (reported_.insert(key).second) {
+    new_failures_.push_back(LoadFailure{key, std::move(failure)});
+    ++stats_.failures;
+  }
+}
+
+void BrickLoader::release_due_retries_locked() {
+  if (retry_.empty()) return;
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& [key, r] : retry_) {
+    if (r.due <= now && failed_.erase(key)) ++stats_.retries;
+  }
+}
+
+void BrickLoader::set_transient_retry(std::chrono::milliseconds first) {
+  if (first.count() < 0 || first > std::chrono::hours(1)) {
+    throw invalid_parameter("retry_after_ms", "must be in [0, 3600000]");
+  }
+  std::lock_guard lock(mutex_);
+  retry_first_ = first;
+  if (first.count() == 0) retry_.clear();
+}
+
+std::size_t BrickLoader::retries_pending() const {
+  std::lock_guard lock(mutex_);
+  std::size_t n = 0;
+  for (const auto& [key, r] : retry_) n += failed_.count(key);
+  return n;
 }
 
 void BrickLoader::wait_idle() {
@@ -334,7 +389,9 @@ std::vector<LoadFailure> BrickLoader::take_failures() {
 
 bool BrickLoader::has_failed(BrickKey key) const {
   std::lock_guard lock(mutex_);
-  return failed_.count(key) != 0;
+  if (failed_.count(key) == 0) return false;
+  const auto r = retry_.find(key);
+  return r == retry_.end() || std::chrono::steady_clock::now() < r->second.due;
 }
 
 std::size_t BrickLoader::queued() const {

@@ -4,6 +4,9 @@
 #include <cctype>
 #include <charconv>
 #include <cstring>
+#include <ctime>
+
+#include <curl/curl.h>
 
 namespace resoct::detail {
 
@@ -37,6 +40,7 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
     a.content_length.reset();
     a.content_range.clear();
     a.error_code.clear();
+    a.retry_after_ms.reset();
     const std::size_t sp = line.find(' ');
     a.status = 0;
     if (sp != std::string_view::npos) {
@@ -58,10 +62,26 @@ std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user) {
     }
   } else if (name == "content-range") {
     a.content_range = std::string(trim(value));
+  } else if (name == "retry-after") {
+    a.retry_after_ms = parse_retry_after(value, std::int64_t(std::time(nullptr)));
   } else if (name == "x-amz-error-code") {
     a.error_code = detail::s3_error_code("<Error><Code>" + std::string(trim(value)) + "</Code>");
   }
   return len;
+}
+
+std::optional<std::uint64_t> parse_retry_after(std::string_view value, std::int64_t now_s) {
+  // Seconds beyond a day are as good as "not soon": the caller caps the wait anyway, and the cap
+  // keeps the product below overflow.
+  constexpr std::uint64_t kMaxSeconds = 86400;
+  if (const std::optional<std::uint64_t> s = parse_u64(value)) {
+    return std::min(*s, kMaxSeconds) * 1000u;
+  }
+  const std::string text(trim(value));
+  const std::int64_t when = std::int64_t(curl_getdate(text.c_str(), nullptr));
+  if (when < 0) return std::nullopt;
+  return std::uint64_t(std::clamp<std::int64_t>(when - now_s, 0, std::int64_t(kMaxSeconds))) *
+         1000u;
 }
 
 std::optional<ContentRange> parse_content_range(std::string_view cr) {

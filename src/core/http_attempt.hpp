@@ -43,6 +43,7 @@ struct Attempt {
   std::string bad_answer;         // set when the server's answer contradicts the request
   std::string error_body;         // the first bytes of an error answer (an S3 <Error> document)
   std::string error_code;         // an x-amz-error-code header (S3 stores; HEAD answers too)
+  std::optional<std::uint64_t> retry_after_ms;  // a Retry-After header (delay or date), in ms
 
   bool ok_status() const { return status >= 200 && status < 300; }
 
@@ -62,6 +63,10 @@ struct Attempt {
     return text;
   }
 };
+
+/// The wait a Retry-After value asks for, in ms: delta-seconds ("120") or an HTTP-date (its
+/// distance from `now_s`, 0 when past); nullopt when it is neither.
+std::optional<std::uint64_t> parse_retry_after(std::string_view value, std::int64_t now_s);
 
 /// libcurl's CURLOPT_HEADERFUNCTION / CURLOPT_WRITEFUNCTION; `user` is the Attempt.
 std::size_t on_header(char* data, std::size_t size, std::size_t n, void* user);

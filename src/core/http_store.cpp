@@ -490,7 +490,12 @@ struct HttpStore::Impl {
       }
       if (o == Outcome::retry && attempt_no < options.retries) {
         ++retries;
-        std::this_thread::sleep_for(std::chrono::milliseconds(delay));
+        // A server that says when to come back (503 or 429 with Retry-After) is waited for, up
+        // to the backoff cap: retrying sooner would only meet the same answer.
+        std::uint64_t wait = delay;
+        if (a.retry_after_ms) wait = std::max<std::uint64_t>(wait, *a.retry_after_ms);
+        wait = std::min<std::uint64_t>(wait, std::max(delay, options.backoff_max_ms));
+        std::this_thread::sleep_for(std::chrono::milliseconds(wait));
         delay = std::min(options.backoff_max_ms, delay * 2);
         continue;
       }

@@ -118,6 +118,9 @@ void RendererOptions::validate() const {
     throw invalid_parameter("prefetch", "max_bricks and max_bytes must be > 0 when enabled");
   }
   if (loader_threads > 1024) throw invalid_parameter("loader_threads", "must be at most 1024");
+  if (retry_failed_after_ms > 3600000u) {
+    throw invalid_parameter("retry_failed_after_ms", "must be at most 3600000 (one hour)");
+  }
   if (brick_request_capacity == 0 || brick_request_capacity > (1u << 28)) {
     throw invalid_parameter("brick_request_capacity", "must be 1..2^28");
   }
@@ -149,6 +152,7 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
   loader_ = std::make_unique<BrickLoader>(
       source_, options_.loader_threads, options_.host_cache_bytes,
       make_host_policy(options_.host_eviction, hierarchy_, host_camera_));
+  loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
   timepoint_ = source_->timepoint();
   timepoint_source_ = source_;
   backend_ = create_backend(options_.backend, options_.backend_options);
@@ -577,7 +581,8 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   report_failures(report);
   stats.resident_bricks = cache_->resident_count();
 
-  report.converged = !outstanding && staged_.empty() && loader_->idle();
+  report.converged =
+      !outstanding && staged_.empty() && loader_->idle() && loader_->retries_pending() == 0;
   report.image = std::move(result_.image);
   result_.image = Image();
   stats.ms_frame = ms_since(t_frame);

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 #include <map>
 #include <mutex>
 #include <random>
@@ -39,8 +41,20 @@ class RecordingSource : public BrickSource {
       std::lock_guard lock(mutex_);
       reads_.push_back(key);
     }
-    if (failing_.count(key)) throw Error(ErrorCode::io, "injected failure");
+    if (failing_.count(key)) {
+      std::lock_guard lock(mutex_);
+      // A failure that passes: the first `fail_times_` reads of each failing key throw.
+      if (fail_times_ < 0 || failed_reads_[key]++ < fail_times_) {
+        throw Error(fail_code_, "injected failure");
+      }
+    }
     inner_.read_brick(key, out);
+  }
+  /// Failing keys throw Error(code) on their first `times` reads (-1: always).
+  void fail_with(ErrorCode code, int times) {
+    std::lock_guard lock(mutex_);
+    fail_code_ = code;
+    fail_times_ = times;
   }
   RegionMeta region_meta(std::uint32_t c, const Box3& b) const override {
     return inner_.region_meta(c, b);
@@ -54,6 +68,9 @@ class RecordingSource : public BrickSource {
  private:
   test::FunctionSource inner_;
   std::set<BrickKey> failing_;
+  ErrorCode fail_code_ = ErrorCode::io;
+  int fail_times_ = -1;
+  mutable std::map<BrickKey, int> failed_reads_;
   mutable std::mutex mutex_;
   mutable std::vector<BrickKey> reads_;
 };
@@ -167,6 +184,75 @@ TEST(BrickLoader, FailuresAreReportedOnceAndNeverRetried) {
   EXPECT_TRUE(loader.take_failures().empty());
   const auto reads = src->reads();
   EXPECT_EQ(std::count(reads.begin(), reads.end(), bad), 1);
+}
+
+TEST(BrickLoader, TransientFailuresAreRetriedAfterTheirDelayAndReportedOnce) {
+  const BrickKey bad(0, 1, {2, 2, 1});
+  auto src = std::make_shared<RecordingSource>(std::set<BrickKey>{bad});
+  src->fail_with(ErrorCode::io, 2);  // fails twice, then reads
+  BrickLoader loader(src, 0, 1 << 20);
+  loader.set_transient_retry(std::chrono::milliseconds(200));
+  const std::vector<LoadRequest> reqs{{bad, 1}};
+  const auto read_count = [&] {
+    const auto r = src->reads();
+    return std::count(r.begin(), r.end(), bad);
+  };
+
+  loader.request(reqs);
+  loader.run_queued(10);
+  ASSERT_EQ(loader.take_failures().size(), 1u);
+  EXPECT_TRUE(loader.has_failed(bad));
+  EXPECT_EQ(loader.retries_pending(), 1u);
+  loader.request(reqs);  // too early: still failed, not read again
+  EXPECT_EQ(loader.run_queued(10), 0u);
+  EXPECT_EQ(read_count(), 1);
+
+  // Sleeps only ever last longer: checks that a retry is not yet due have 150 ms or more of
+  // margin, checks that it is due have none to lose.
+  std::this_thread::sleep_for(std::chrono::milliseconds(210));
+  EXPECT_FALSE(loader.has_failed(bad));  // due
+  loader.request(reqs);
+  loader.run_queued(10);  // the second failure: reported before, so not again
+  EXPECT_TRUE(loader.take_failures().empty());
+  EXPECT_EQ(read_count(), 2);
+  EXPECT_TRUE(loader.has_failed(bad));  // now 400 ms: twice the delay
+  std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  EXPECT_TRUE(loader.has_failed(bad));
+  std::this_thread::sleep_for(std::chrono::milliseconds(160));
+  loader.request(reqs);
+  loader.run_queued(10);
+  EXPECT_EQ(read_count(), 3);
+  ASSERT_EQ(loader.take_ready().size(), 1u);  // the third read succeeded
+  EXPECT_FALSE(loader.has_failed(bad));
+  EXPECT_EQ(loader.retries_pending(), 0u);
+  EXPECT_EQ(loader.stats().retries, 2u);
+  EXPECT_EQ(loader.stats().failures, 1u);
+}
+
+TEST(BrickLoader, CorruptDataIsNeverRetried) {
+  const BrickKey bad(0, 1, {2, 2, 1});
+  auto src = std::make_shared<RecordingSource>(std::set<BrickKey>{bad});
+  src->fail_with(ErrorCode::checksum_mismatch, 1);  // would read on the second try
+  BrickLoader loader(src, 0, 1 << 20);
+  loader.set_transient_retry(std::chrono::milliseconds(1));
+  const std::vector<LoadRequest> reqs{{bad, 1}};
+  loader.request(reqs);
+  loader.run_queued(10);
+  ASSERT_EQ(loader.take_failures().size(), 1u);
+  EXPECT_EQ(loader.retries_pending(), 0u);
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(loader.has_failed(bad));
+  loader.request(reqs);
+  EXPECT_EQ(loader.run_queued(10), 0u);
+  EXPECT_EQ(loader.stats().retries, 0u);
+}
+
+TEST(BrickLoader, TransientRetryDelayIsChecked) {
+  BrickLoader loader(std::make_shared<RecordingSource>(), 0, 1 << 20);
+  EXPECT_RESOCT_ERROR(loader.set_transient_retry(std::chrono::hours(2)),
+                      ErrorCode::invalid_argument, "retry_after_ms");
+  EXPECT_RESOCT_ERROR(loader.set_transient_retry(std::chrono::milliseconds(-1)),
+                      ErrorCode::invalid_argument, "retry_after_ms");
 }
 
 TEST(BrickLoader, ThreadsReadEveryKeyExactlyOnce) {

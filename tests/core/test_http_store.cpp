@@ -199,6 +199,26 @@ TEST_F(HttpStoreTest, RetriesTransientServerErrors) {
   EXPECT_EQ(s.stats().retries, 4u);
 }
 
+TEST_F(HttpStoreTest, WaitsAsLongAsRetryAfterAsksUpToTheBackoffCap) {
+  // /busy answers the first request of each path with 503 and "Retry-After: 1".
+  HttpOptions o = fast_http_options();
+  o.backoff_max_ms = 2000;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto b = store("busy", o).get("blob.bin", data_.size());
+  const double waited_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(b.has_value());
+  EXPECT_TRUE(*b == data_);
+  EXPECT_GE(waited_ms, 1000.0);  // not the 10 ms backoff
+  // With a cap below the asked second the cap wins (a second path: its own first 503).
+  o.backoff_max_ms = 20;
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_EQ(store("busy", o).get_range("0/1.2.3", 0, 10).size(), 10u);
+  const double capped_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+  EXPECT_LT(capped_ms, 900.0);
+}
+
 TEST_F(HttpStoreTest, GivesUpAfterTheConfiguredRetries) {
   HttpStore s = store("fail");
   EXPECT_RESOCT_ERROR(s.get("blob.bin", 1 << 20), ErrorCode::io,

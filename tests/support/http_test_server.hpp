@@ -20,6 +20,14 @@ class HttpTestServer {
       : process_({"/usr/bin/python3", script, root}, "http test server (" + script + ")") {}
 
   int port() const { return process_.port(); }
+  /// The body of GET /<path> (a control path such as "_stats" or "_chaos/300/1"); throws as
+  /// HttpStore does, and std::runtime_error when it is absent.
+  std::string get(const std::string& path) const {
+    HttpStore s(parse_url_map("http://127.0.0.1:" + std::to_string(port())));
+    const auto body = s.get(path, 1 << 20);
+    if (!body) throw std::runtime_error("http test server: no " + path);
+    return std::string(reinterpret_cast<const char*>(body->data()), body->size());
+  }
   /// "http://127.0.0.1:<port>/<mode>" (see the script for the modes).
   std::string base(const std::string& mode = "ok") const {
     return "http://127.0.0.1:" + std::to_string(port()) + "/" + mode;

@@ -24,22 +24,35 @@ The first path component selects a behaviour, the rest names the file below ROOT
   /redirect-https/F 302 to https://127.0.0.1:<this port>/ok/F (another scheme)
   /redirect-file/F  302 to file:///etc/passwd
   /redirect-ftp/F   302 to ftp://127.0.0.1/F
-  /_stats      JSON {"connections": n, "requests": n} since start or the last /_reset
-  /_reset      zeroes the counters and the /flaky attempt counts
+  /busy/F      503 with "Retry-After: 1" for the first request of each path, then like /ok
+  /chaos/F     like /ok, except that each request draws, with the probability set by /_chaos, one
+               fault at random: 404, 500, 503 with Retry-After, a truncated body, a wrong
+               Content-Range, a stall past the client's timeout, or a connection reset
+  /_chaos/P/S  sets the /chaos fault probability to P per mille (0: healed) and reseeds its
+               random generator with S, so a run's faults repeat for the same request order
+  /_stats      JSON {"connections": n, "requests": n, "faults": {kind: n}} since start or the
+               last /_reset
+  /_reset      zeroes the counters and the /flaky and /busy attempt counts
 """
 import http.server
 import json
 import os
 import re
+import random
 import socket
+import struct
 import sys
 import threading
 import time
 
 ROOT = os.path.realpath(sys.argv[1])
 LOCK = threading.Lock()
-STATS = {"connections": 0, "requests": 0}
+STATS = {"connections": 0, "requests": 0, "faults": {}}
 FLAKY = {}
+CHAOS = {"permille": 0, "rng": random.Random(0)}
+FAULTS = ("404", "500", "503", "truncate", "bad_range", "stall", "reset")
+# A stall outlasts any client timeout the tests set (fault-injection options: 1.5 s at most).
+STALL_S = 3.0
 
 
 class Handler(http.server.BaseHTTPRequestHandler):
@@ -84,7 +97,18 @@ class Handler(http.server.BaseHTTPRequestHandler):
             with LOCK:
                 STATS["connections"] = 0
                 STATS["requests"] = 0
+                STATS["faults"] = {}
                 FLAKY.clear()
+            return self.send_bytes(200, b"{}", send_body=send_body)
+        if mode == "_chaos":
+            args = (parts[1] if len(parts) > 1 else "").split("/")
+            try:
+                permille, seed = int(args[0]), int(args[1])
+            except (IndexError, ValueError):
+                return self.send_bytes(400, b"usage: /_chaos/PERMILLE/SEED", send_body=send_body)
+            with LOCK:
+                CHAOS["permille"] = max(0, min(1000, permille))
+                CHAOS["rng"] = random.Random(seed)
             return self.send_bytes(200, b"{}", send_body=send_body)
         rel = parts[1] if len(parts) > 1 else ""
         if mode.startswith("redirect-"):
@@ -112,10 +136,42 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 n = FLAKY[rel]
             if n <= 2:
                 return self.send_bytes(500, b"try again", send_body=send_body)
+        if mode == "busy":
+            with LOCK:
+                FLAKY["busy/" + rel] = FLAKY.get("busy/" + rel, 0) + 1
+                n = FLAKY["busy/" + rel]
+            if n <= 1:
+                return self.send_bytes(503, b"busy", [("Retry-After", "1")], send_body)
         if mode == "stall":
             time.sleep(60)
             return
         size = os.path.getsize(path)
+        fault = None
+        if mode == "chaos":
+            with LOCK:
+                rng = CHAOS["rng"]
+                if rng.randrange(1000) < CHAOS["permille"]:
+                    fault = rng.choice(FAULTS)
+                    STATS["faults"][fault] = STATS["faults"].get(fault, 0) + 1
+            if fault == "404":
+                return self.send_bytes(404, b"not found", send_body=send_body)
+            if fault == "500":
+                return self.send_bytes(500, b"server error", send_body=send_body)
+            if fault == "503":
+                return self.send_bytes(503, b"busy", [("Retry-After", "1")], send_body)
+            if fault == "stall":
+                time.sleep(STALL_S)
+                self.close_connection = True
+                return
+            if fault == "reset":
+                # SO_LINGER with a zero timeout: close() sends a TCP RST instead of a FIN.
+                self.connection.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER,
+                                           struct.pack("ii", 1, 0))
+                self.connection.close()
+                self.close_connection = True
+                return
+            if fault == "truncate":
+                mode = "truncate"
 
         def read(first, count):
             # Only the bytes sent: whole-file reads would make every range request cost the file.
@@ -133,7 +189,7 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 self.wfile.flush()
             self.close_connection = True
             return
-        if mode not in ("ok", "flaky", "norange", "nosuffix"):
+        if mode not in ("ok", "flaky", "norange", "nosuffix", "busy", "chaos"):
             return self.send_bytes(400, b"unknown mode", send_body=send_body)
         rng = self.headers.get("Range")
         if mode == "norange" or rng is None:
@@ -160,6 +216,10 @@ class Handler(http.server.BaseHTTPRequestHandler):
         if first >= size:
             return self.send_bytes(416, b"", [("Content-Range", "bytes */%d" % size)], send_body)
         last = min(last, size - 1)
+        if fault == "bad_range":
+            # The bytes of another range than the one asked for, labelled as such.
+            first = first + 1 if last + 1 < size else max(0, first - 1)
+            last = min(size - 1, first + (last - first))
         self.send_bytes(206, read(first, last + 1 - first),
                         [("Content-Range", "bytes %d-%d/%d" % (first, last, size))], send_body)
 
