@@ -120,20 +120,26 @@ struct Rig {
   }
 };
 
-/// Brute-force check of the renderer's state; returns the first problem or "".
-inline std::string check_state(const Renderer& r, const RecordingBackend& b,
-                               const BrickSource& src) {
+/// Brute-force check of the renderer's state against the source: octree invariants, every page
+/// entry against its brick's metadata, every resident cache slot against its entry; with a
+/// recording backend `b` also its mirrors of the pool, directory, nodes and slot voxels. Returns
+/// the first problem or "".
+inline std::string check_renderer_state(const Renderer& r, const RecordingBackend* b,
+                                        const BrickSource& src) {
   if (auto e = r.octree().check_invariants()) return "octree: " + *e;
-  const auto& pool = r.page_table().pool();
-  if (b.pages().size() < pool.size() || !std::equal(pool.begin(), pool.end(), b.pages().begin()) ||
-      !std::all_of(b.pages().begin() + std::ptrdiff_t(pool.size()), b.pages().end(),
-                   [](std::uint32_t w) { return w == 0u; })) {
-    return "page pool mirror differs from host";
-  }
-  if (b.directory() != r.page_table().directory()) return "directory mirror differs from host";
-  const auto words = r.octree().words();
-  if (!std::equal(words.begin(), words.end(), b.nodes().begin(), b.nodes().end())) {
-    return "node mirror differs from host";
+  if (b) {
+    const auto& pool = r.page_table().pool();
+    if (b->pages().size() < pool.size() ||
+        !std::equal(pool.begin(), pool.end(), b->pages().begin()) ||
+        !std::all_of(b->pages().begin() + std::ptrdiff_t(pool.size()), b->pages().end(),
+                     [](std::uint32_t w) { return w == 0u; })) {
+      return "page pool mirror differs from host";
+    }
+    if (b->directory() != r.page_table().directory()) return "directory mirror differs from host";
+    const auto words = r.octree().words();
+    if (!std::equal(words.begin(), words.end(), b->nodes().begin(), b->nodes().end())) {
+      return "node mirror differs from host";
+    }
   }
   const BrickHierarchy& h = r.hierarchy();
   const std::size_t bytes = h.layout().padded_voxels();
@@ -164,8 +170,9 @@ inline std::string check_state(const Renderer& r, const RecordingBackend& b,
               if (meta.constant) return where + "constant brick holds a cache slot";
               const std::uint32_t slot = kernel::resoct_page_cache_slot(e);
               if (r.cache().key_of(slot) != key) return where + "cache slot holds another key";
+              if (!b) continue;
               src.read_brick(key, voxels);
-              const auto dev = b.slot_voxels(slot);
+              const auto dev = b->slot_voxels(slot);
               if (!std::equal(dev.begin(), dev.end(), voxels.begin(), voxels.end())) {
                 return where + "device slot voxels differ from the source";
               }
@@ -185,6 +192,12 @@ inline std::string check_state(const Renderer& r, const RecordingBackend& b,
     }
   }
   return "";
+}
+
+/// check_renderer_state with the recording backend's mirrors.
+inline std::string check_state(const Renderer& r, const RecordingBackend& b,
+                               const BrickSource& src) {
+  return check_renderer_state(r, &b, src);
 }
 
 }  // namespace resoct::test
