@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <string>
@@ -184,6 +186,31 @@ TEST_F(ToolExitCodes, ConvertOnAFullDiskIs1AndLeavesTheOldStore) {
       << r.err;
   EXPECT_NE(last.find(": offset "), std::string::npos) << r.err;
   EXPECT_NE(last.find(": write failed"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir_.file("out.rbs")), kPrevious);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"out.rbs"}));
+}
+
+TEST_F(ToolExitCodes, ConvertIntoAReadOnlyDirectoryIs1AndLeavesTheOldStore) {
+  // A directory the tool may not write (mode 0555). Root ignores directory permissions through
+  // CAP_DAC_OVERRIDE, so under root (CI) the tool runs with that capability (and its relatives)
+  // dropped from its bounding set: still uid 0, but held to the permission bits like any user.
+  put("out.rbs", kPrevious);
+  namespace fs = std::filesystem;
+  fs::permissions(dir_.path(), fs::perms::owner_write | fs::perms::group_write,
+                  fs::perm_options::remove);
+  const std::string drop =
+      ::geteuid() == 0 ? "setpriv --bounding-set=-dac_override,-dac_read_search,-fowner -- " : "";
+  const ToolRun r = resoct::test::run_tool_process(
+      dir_.path().string(), "/bin/sh",
+      "-c " + shell_quote("exec " + drop + shell_quote(RESOCT_CONVERT) +
+                          " procedural:turbulence:32x32x32 " + shell_quote(dir_.file("out.rbs")) +
+                          " --brick 16 --threads 1"));
+  fs::permissions(dir_.path(), fs::perms::owner_write, fs::perm_options::add);
+  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+  EXPECT_EQ(last_line(r.err), "resoct-convert: error [io]: " + dir_.file("out.rbs") +
+                                  ": offset 0: cannot create a temporary file next to it: "
+                                  "Permission denied")
+      << r.err;
   EXPECT_EQ(slurp(dir_.file("out.rbs")), kPrevious);
   EXPECT_EQ(entries(), (std::vector<std::string>{"out.rbs"}));
 }
