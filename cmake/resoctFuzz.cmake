@@ -5,6 +5,8 @@
 # compiler whenever the tests are built.
 option(RESOCT_BUILD_FUZZ "Build the libFuzzer targets in fuzz/ (clang; ASan + UBSan)" OFF)
 set(RESOCT_FUZZ_SECONDS 60 CACHE STRING "Seconds each libFuzzer target runs in ctest label fuzz")
+set(RESOCT_FUZZ_RUNS 0 CACHE STRING
+    "Executions after which each libFuzzer target stops in ctest label fuzz (0: time only)")
 
 if(RESOCT_BUILD_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
