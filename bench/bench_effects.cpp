@@ -1,7 +1,7 @@
-// What each effect costs (DESIGN.md §6, issue "Effects on demand"): per dataset, every effect
-// alone and combined against the plain path in one process, CPU backend, one thread, every level
-// resident, the orbit of bench_table1. Each benchmark renders one configuration over the orbit;
-// the plain configuration runs first per dataset and the others report their ratio to it.
+// What each effect costs (docs/architecture.md §4, issue "Effects on demand"): per dataset, every
+// effect alone and combined against the plain path in one process, CPU backend, one thread, every
+// level resident, the orbit of bench_table1. Each benchmark renders one configuration over the
+// orbit; the plain configuration runs first per dataset and the others report their ratio to it.
 //
 //   BM_Effects/dataset:<d>/config:<c>
 //     d = 0 tubes (1 channel), 1 turbulence (1 channel), 2 cells (4 of 16 channels)

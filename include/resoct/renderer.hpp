@@ -2,7 +2,7 @@
 /// \file
 /// The frame loop: owns the host-side residency state (page table, brick cache, residency
 /// octree, channel map), a BrickLoader and a Backend, and turns a Scene into images frame by
-/// frame (DESIGN.md §5). See docs/renderer.md.
+/// frame (docs/architecture.md §2). See docs/renderer.md.
 
 #include <cstdint>
 #include <functional>

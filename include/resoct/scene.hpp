@@ -19,7 +19,7 @@
 
 namespace resoct {
 
-/// Optional rendering effects a scene may request (DESIGN.md §6).
+/// Optional rendering effects a scene may request (docs/architecture.md §4).
 enum class Effect : std::uint8_t { shading, shadows };
 /// "shading" / "shadows".
 const char* to_string(Effect e) noexcept;

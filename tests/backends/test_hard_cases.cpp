@@ -1,7 +1,7 @@
-// DESIGN.md §7 hard cases through the traversal kernel on every backend (cpu, and vulkan when
-// built: tests/backends/backend_test_util.hpp). Every render asserts that the iteration cap was
-// never hit (termination) and compares against a brute-force definition: the reference renderer,
-// a closed form, or the background.
+// The hard cases of docs/architecture.md §5 through the traversal kernel on every backend (cpu,
+// and vulkan when built: tests/backends/backend_test_util.hpp). Every render asserts that the
+// iteration cap was never hit (termination) and compares against a brute-force definition: the
+// reference renderer, a closed form, or the background.
 #include <cmath>
 #include <cstdio>
 #include <limits>

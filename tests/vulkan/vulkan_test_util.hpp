@@ -81,12 +81,12 @@ inline constexpr double kVulkanColourTolerance = 1e-4;
 
 /// Compares a Vulkan frame with the CPU frame of the same state and tables.
 ///
-/// Integer outputs must be identical (DESIGN.md §7): statistics, request keys and hit counts,
-/// and the used cache slots (the working set). Colours may differ by float rounding: measured on
-/// lavapipe at most 1.4e-5 (oracle scenes), 4.5e-6 (effects), 2.7e-6 (slices), asserted within
-/// kVulkanColourTolerance = 1e-4 (a real GPU's exp2/log2 and fused multiply-adds round a little
-/// differently; 2/255 would hide a wrong sample). The march ends a sliver before the exit
-/// (RESOCT_SEGMENT_EPS), so the last ulp of the device's division cannot add a sample.
+/// Integer outputs must be identical (docs/architecture.md §3.4): statistics, request keys and
+/// hit counts, and the used cache slots (the working set). Colours may differ by float rounding:
+/// measured on lavapipe at most 1.4e-5 (oracle scenes), 4.5e-6 (effects), 2.7e-6 (slices),
+/// asserted within kVulkanColourTolerance = 1e-4 (a real GPU's exp2/log2 and fused multiply-adds
+/// round a little differently; 2/255 would hide a wrong sample). The march ends a sliver before
+/// the exit (RESOCT_SEGMENT_EPS), so the last ulp of the device's division cannot add a sample.
 /// `diff` accumulates the largest differences for the report line.
 inline void expect_same_frame(const FrameResult& cpu, const FrameResult& gpu,
                               const std::string& what, OracleDiff& diff) {

@@ -1,4 +1,4 @@
-// resoct kernel: effect specialization (DESIGN.md §6) and Blinn-Phong shading.
+// resoct kernel: effect specialization (docs/architecture.md §4) and Blinn-Phong shading.
 //
 // A scene's effects and channel modes form a bit mask, RESOCT_EFFECTS. The kernel code that
 // depends on it is written once and specialized per mask:
