@@ -104,6 +104,23 @@ CameraRays::CameraRays(const Camera& camera, const Viewport& viewport)
   }
 }
 
+Camera orbit(const Camera& camera, double degrees) {
+  if (!std::isfinite(degrees)) throw invalid_parameter("degrees", "must be finite");
+  const double len = glm::length(camera.up);
+  if (!finite3(camera.up) || !(len > 0.0)) {
+    throw invalid_parameter("camera.up", "must be a finite non-zero vector");
+  }
+  // Rodrigues' rotation of the eye's offset from the target about the unit up axis.
+  const glm::dvec3 k = camera.up / len;
+  const glm::dvec3 v = camera.eye - camera.target;
+  const double a = degrees * std::numbers::pi / 180.0;
+  const glm::dvec3 rotated =
+      v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1.0 - std::cos(a));
+  Camera out = camera;
+  out.eye = camera.target + rotated;
+  return out;
+}
+
 Ray CameraRays::ray(double x, double y) const {
   // Image-plane coordinates in units of half heights: u to the right, v up (row 0 at the top).
   const double rows = double(viewport_.height);
