@@ -8,9 +8,9 @@
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/kernel/tf.glsl.h"
 #include "resoct/page_table.hpp"
 #include "resoct/residency_octree.hpp"
+#include "resoct/transfer_function.hpp"
 #include "resoct/version.hpp"
 
 namespace resoct::test {
@@ -36,7 +36,7 @@ TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
   EXPECT_EQ(k::RESOCT_NODE_FLAGS, 3u) << bump;
   EXPECT_EQ(k::RESOCT_REQUEST_IN_BLOCK_BITS, 12u) << bump;
   EXPECT_EQ(k::RESOCT_REQUEST_BLOCK_MISS_BIT, 0x80000000u) << bump;
-  EXPECT_EQ(k::RESOCT_TF_LUT_SIZE, 1024u) << bump;
+  EXPECT_EQ(kTfLutSize, 1024u) << bump;  // RESOCT_TF_LUT_SIZE (tf.glsl.h is not standalone)
   EXPECT_EQ(k::RESOCT_MAX_SLOTS, 32u) << bump;
 }
 
