@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "resoct/error.hpp"
 
@@ -110,12 +111,14 @@ Camera orbit(const Camera& camera, double degrees) {
   if (!finite3(camera.up) || !(len > 0.0)) {
     throw invalid_parameter("camera.up", "must be a finite non-zero vector");
   }
-  // Rodrigues' rotation of the eye's offset from the target about the unit up axis.
+  // Rotates the eye's offset from the target about the unit up axis: the part along the axis
+  // stays, the rest turns in the plane perpendicular to it. Written so that an axis-aligned up
+  // keeps that coordinate exactly (a turntable about +y never drifts in height).
   const glm::dvec3 k = camera.up / len;
   const glm::dvec3 v = camera.eye - camera.target;
-  const double a = degrees * std::numbers::pi / 180.0;
-  const glm::dvec3 rotated =
-      v * std::cos(a) + glm::cross(k, v) * std::sin(a) + k * glm::dot(k, v) * (1.0 - std::cos(a));
+  const glm::dvec3 along = k * glm::dot(k, v);
+  const double a = glm::radians(degrees);
+  const glm::dvec3 rotated = along + (v - along) * std::cos(a) + glm::cross(k, v) * std::sin(a);
   Camera out = camera;
   out.eye = camera.target + rotated;
   return out;

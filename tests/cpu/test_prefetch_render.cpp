@@ -37,16 +37,6 @@ RendererOptions sync_options() {
   return o;
 }
 
-/// The camera orbiting the volume centre by `deg` degrees about the y axis.
-Camera orbit(const Camera& c, double deg) {
-  const double a = glm::radians(deg);
-  const glm::dvec3 d = c.eye - c.target;
-  Camera out = c;
-  out.eye = c.target + glm::dvec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y,
-                                  -std::sin(a) * d.x + std::cos(a) * d.z);
-  return out;
-}
-
 }  // namespace
 
 TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
