@@ -58,19 +58,19 @@ std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
   return std::uint32_t(blocks);
 }
 
-// Options are validated before the policies are made, so `e` is one of the two.
-std::unique_ptr<EvictionPolicy> make_policy(Eviction e, const BrickHierarchy& h,
+// Options are validated before the policies are made, so `policy` is one of the two.
+std::unique_ptr<EvictionPolicy> make_policy(Eviction policy, const BrickHierarchy& h,
                                             const glm::dvec3* camera) {
-  if (e == Eviction::lru) return std::make_unique<LruPolicy>();
+  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
   // Distances in physical units from the camera of the frame being rendered.
   return std::make_unique<OctreemizerPolicy>(
       h.level_count(), OctreemizerWeights{},
       [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
 }
 
-std::unique_ptr<EvictionPolicy> make_host_policy(Eviction e, const BrickHierarchy& h,
+std::unique_ptr<EvictionPolicy> make_host_policy(Eviction policy, const BrickHierarchy& h,
                                                  std::shared_ptr<SharedEye> eye) {
-  if (e == Eviction::lru) return std::make_unique<LruPolicy>();
+  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
   return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
                                              [&h, eye](BrickKey key) {
                                                glm::dvec3 e;

@@ -53,7 +53,9 @@ TEST(OverviewScene, FirstChannelsVisibleInColoursOfTheirOwn) {
     EXPECT_FALSE(s.channels[c].tf.fully_transparent());
     EXPECT_EQ(s.channels[c].tf.evaluate(0.0).a, 0.0);  // background values stay transparent
     EXPECT_GT(s.channels[c].tf.evaluate(1.0).a, 0.0);
-    if (c > 0) EXPECT_NE(s.channels[c].tf.evaluate(1.0), s.channels[0].tf.evaluate(1.0));
+    if (c > 0) {
+      EXPECT_NE(s.channels[c].tf.evaluate(1.0), s.channels[0].tf.evaluate(1.0));
+    }
   }
   EXPECT_NO_THROW(s.validate(v));
   EXPECT_EQ(overview_scene(volume({8, 8, 8}, 1)).channels.size(), 1u);
