@@ -40,8 +40,8 @@ BrickLayout layout_of(std::uint32_t brick, std::uint32_t halo) {
   return layout;
 }
 
-Source open(const std::string& spec, std::uint32_t brick, std::uint32_t halo,
-            const std::string& s3_endpoint, bool no_sign_request) {
+Source open_spec(const std::string& spec, std::uint32_t brick, std::uint32_t halo,
+                 const std::string& s3_endpoint, bool no_sign_request) {
   SourceOptions options;
   options.s3.endpoint = s3_endpoint;
   options.s3.anonymous = no_sign_request;
@@ -167,7 +167,7 @@ void bind_sources(py::module_& m) {
                std::to_string(volume(s).channels) + " channels>";
       });
 
-  m.def("open_source", &open, py::arg("spec"), py::kw_only(), py::arg("brick") = 32u,
+  m.def("open_source", &open_spec, py::arg("spec"), py::kw_only(), py::arg("brick") = 32u,
         py::arg("halo") = 1u, py::arg("s3_endpoint") = "", py::arg("no_sign_request") = false,
         ("Opens a source as the command-line tools do: " + std::string(kSourceSpecForms) +
          ". `brick` and `halo` brick the formats that are not brick stores; `s3_endpoint` and "
