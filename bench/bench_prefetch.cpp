@@ -19,8 +19,6 @@
 #include <string>
 #include <thread>
 
-#include <glm/trigonometric.hpp>
-
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/procedural_source.hpp"
 #include "resoct/renderer.hpp"
@@ -51,15 +49,6 @@ class SlowSource final : public BrickSource {
   std::unique_ptr<BrickSource> inner_;
   std::chrono::microseconds latency_;
 };
-
-Camera orbit(const Camera& c, double deg) {
-  const double a = glm::radians(deg);
-  const glm::dvec3 d = c.eye - c.target;
-  Camera out = c;
-  out.eye = c.target + glm::dvec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y,
-                                  -std::sin(a) * d.x + std::cos(a) * d.z);
-  return out;
-}
 
 /// Pose of frame f (held at the last pose after the path): kind 0 orbits the volume centre by
 /// 5 degrees a frame; kind 1 flies towards the centre, from 1.0 to 0.45 of the start distance,

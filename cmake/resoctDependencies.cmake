@@ -30,3 +30,21 @@ endif()
 if(RESOCT_BUILD_BENCH)
   find_package(benchmark REQUIRED)
 endif()
+
+# Python bindings (pybind11-dev, python3-dev, python3-numpy): Debian's interpreter, for which those
+# packages are built, unless -DPython_EXECUTABLE= names another. A python3 earlier on PATH (pyenv,
+# a virtualenv) usually lacks numpy and Debian's pybind11.
+if(NOT DEFINED Python_EXECUTABLE AND EXISTS /usr/bin/python3)
+  set(Python_EXECUTABLE /usr/bin/python3)
+endif()
+find_package(Python 3.8 QUIET COMPONENTS Interpreter Development.Module)
+set(RESOCT_PYTHON_FOUND OFF)
+if(Python_FOUND)
+  set(PYBIND11_FINDPYTHON ON)
+  find_package(pybind11 CONFIG QUIET)
+  execute_process(COMMAND ${Python_EXECUTABLE} -c "import numpy" RESULT_VARIABLE _resoct_numpy_rc
+                  OUTPUT_QUIET ERROR_QUIET)
+  if(pybind11_FOUND AND _resoct_numpy_rc EQUAL 0)
+    set(RESOCT_PYTHON_FOUND ON)
+  endif()
+endif()

@@ -77,12 +77,6 @@ struct PlayedTimepoint {
   double ms = 0.0;  // wall time of its frames
 };
 
-RequestStrategy parse_strategy(const std::string& s) {
-  if (s == "greedy") return RequestStrategy::greedy;
-  if (s == "global") return RequestStrategy::global;
-  throw invalid_parameter("strategy", "'" + s + "' is not one of greedy, global");
-}
-
 /// Totals over all frames rendered.
 struct Totals {
   std::uint64_t requests = 0;
@@ -103,10 +97,6 @@ struct Totals {
   }
 };
 
-double per_ray(std::uint64_t v, std::uint64_t rays) {
-  return rays == 0 ? 0.0 : double(v) / double(rays);
-}
-
 void write_stats(const std::string& path, const Args& a, const FrameReport& last,
                  std::uint32_t frames, bool converged, double steady_ms, std::uint32_t steady_count,
                  const Totals& t, const Renderer& r, const std::vector<PlayedTimepoint>& played) {
@@ -126,10 +116,10 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   j["ms_render_last"] = s.ms_render;
   j["ms_device_last"] = s.backend.ms_device;
   j["rays"] = s.backend.rays;
-  j["samples_per_ray"] = per_ray(s.backend.samples, s.backend.rays);
-  j["nodes_per_ray"] = per_ray(s.backend.nodes_visited, s.backend.rays);
-  j["iterations_per_ray"] = per_ray(s.backend.iterations, s.backend.rays);
-  j["brick_accesses_per_ray"] = per_ray(s.backend.brick_accesses, s.backend.rays);
+  j["samples_per_ray"] = per_ray(s.backend.samples, s.backend);
+  j["nodes_per_ray"] = per_ray(s.backend.nodes_visited, s.backend);
+  j["iterations_per_ray"] = per_ray(s.backend.iterations, s.backend);
+  j["brick_accesses_per_ray"] = per_ray(s.backend.brick_accesses, s.backend);
   // Effects (last frame): gradients computed and shadow rays cast; 0 without effects.
   j["gradient_evals"] = s.backend.gradient_evals;
   j["shadow_rays"] = s.backend.shadow_rays;
@@ -200,7 +190,7 @@ int run(const Args& a) {
   o.backend_options.device = a.device;
   o.backend_options.validation = a.validation;
   o.mode = parse_render_mode(a.mode);
-  o.strategy = parse_strategy(a.strategy);
+  o.strategy = parse_request_strategy(a.strategy);
   if (a.cache_mb == 0 || a.cache_mb > (std::uint64_t(1) << 24)) {
     throw invalid_parameter("cache-mb", "must be 1..2^24");
   }

@@ -15,6 +15,8 @@ PACKAGES=(
   python3-zarr python3-numcodecs python3-numpy mricron-data
   # HTTP tests and bench_http: /usr/bin/python3 runs tests/support/http_test_server.py
   python3
+  # the Python module (python/) and its tests: pybind11 and the headers of Debian's python3
+  pybind11-dev python3-dev
 )
 
 missing=()

@@ -7,6 +7,10 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/install-test-tools.sh
 bash scripts/check-format.sh
+# install-deps.sh installs pybind11, the Python headers and numpy, so the Python module must be
+# built (and its tests run): configuring fails rather than leaving it out. RESOCT_REQUIRE_PYTHON=0
+# opts out.
+export RESOCT_REQUIRE_PYTHON="${RESOCT_REQUIRE_PYTHON:-1}"
 bash scripts/build.sh release
 # install-deps.sh installs lavapipe, so Vulkan must work here: a Vulkan test that would skip for
 # want of a driver fails instead (docs/testing.md). RESOCT_REQUIRE_VULKAN=0 opts out.

@@ -32,6 +32,13 @@ struct Camera {
   friend bool operator==(const Camera&, const Camera&) = default;
 };
 
+/// The camera moved on a circle around its target: the eye turns by `degrees` about the axis
+/// through the target along `up` (counter-clockwise seen from above, i.e. looking down `-up`);
+/// target, up and the lens stay. Orbiting in small steps is a viewer's turntable. Throws
+/// Error(invalid_argument) naming "camera.up" when up is zero or not finite, "degrees" when it
+/// is not finite.
+Camera orbit(const Camera& camera, double degrees);
+
 struct Viewport {
   std::uint32_t width = 512;   ///< pixels, 1..16384
   std::uint32_t height = 512;  ///< pixels, 1..16384

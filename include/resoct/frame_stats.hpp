@@ -60,6 +60,9 @@ struct FrameStats {
   double ms_frame = 0.0;     ///< the whole render_frame
 };
 
+/// `total` divided by the frame's rays (0 without rays): samples, nodes or iterations per ray.
+double per_ray(std::uint64_t total, const BackendStats& stats) noexcept;
+
 /// One human-readable line for progress output, e.g.
 /// "frame 3: 120 requests, 64 uploaded, 2 deferred, 1.2 ms render".
 std::string format_frame_line(const FrameStats& s);

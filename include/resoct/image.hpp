@@ -3,6 +3,7 @@
 /// RGBA float images, 8-bit conversion, PNG files and image comparison metrics.
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ class Image {
 
   /// 8-bit RGBA, 4 bytes per pixel: round(clamp(v, 0, 1) * 255); NaN becomes 0.
   std::vector<std::uint8_t> to_rgba8() const;
+  /// The same into `out` (resized; its capacity is reused, so a viewer converts every frame
+  /// without allocating).
+  void to_rgba8(std::vector<std::uint8_t>& out) const;
   /// Inverse of to_rgba8 (v / 255). Throws Error(size_mismatch) if the buffer size is wrong.
   static Image from_rgba8(std::uint32_t width, std::uint32_t height,
                           const std::vector<std::uint8_t>& rgba);
@@ -43,6 +47,10 @@ class Image {
 /// Writes an 8-bit RGBA PNG atomically: a temporary "<path>.tmp-XXXXXX" in the same directory,
 /// fsync, rename. On failure removes the temporary and throws Error(io) naming the path.
 void write_png(const Image& image, const std::string& path);
+/// The same for 8-bit RGBA pixels (FrameReport::rgba8): `rgba` must hold width * height * 4
+/// bytes, else Error(invalid_argument) naming "rgba"; a side outside 1..65536 names "image size".
+void write_png(std::uint32_t width, std::uint32_t height, std::span<const std::uint8_t> rgba,
+               const std::string& path);
 /// Reads any PNG libpng understands, converted to 8-bit RGBA. Error(io) when the file cannot be
 /// opened, Error(corrupt) naming the path when it is not a valid PNG.
 Image read_png(const std::string& path);

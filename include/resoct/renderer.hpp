@@ -6,13 +6,9 @@
 
 #include <cstdint>
 #include <functional>
-#include <limits>
-#include <algorithm>
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <string>
-#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -28,78 +24,25 @@
 #include "resoct/octree_layout.hpp"
 #include "resoct/page_table.hpp"
 #include "resoct/prefetch.hpp"
+#include "resoct/renderer_options.hpp"
 #include "resoct/request_set.hpp"
 #include "resoct/residency_octree.hpp"
 #include "resoct/scene.hpp"
 
 namespace resoct {
 
-/// Prefetching ahead of camera motion (paper 001; docs/renderer.md, "Prefetching"). Each frame
-/// the camera's next `lookahead_frames` poses are extrapolated linearly from its last two, and
-/// up to `max_bricks` / `max_bytes` (padded voxel bytes) bricks those views may need and that are
-/// neither on the device nor in the host cache are queued for loading into the host cache, below
-/// every real request.
-///
-/// Playing a time series (`next_timepoint`): each frame also queues, below the camera's
-/// prefetches, up to the same budget of bricks of the next timepoint (scene timepoint + 1,
-/// wrapping to 0) that the current view may need and the host cache lacks, so that switching to
-/// it is served from host memory (docs/renderer.md "Time series").
-struct PrefetchOptions {
-  std::uint32_t lookahead_frames = 0;                 ///< 0 disables prefetching; at most 64
-  std::uint32_t max_bricks = 64;                      ///< per frame, > 0 when enabled
-  std::uint64_t max_bytes = std::uint64_t(64) << 20;  ///< per frame, > 0 when enabled
-  bool next_timepoint = false;  ///< prefetch the next timepoint (no effect without a t axis)
-};
-
-/// Construction parameters of a Renderer; validate() names the offending field.
-struct RendererOptions {
-  std::string backend = "cpu";  ///< a name registered with register_backend()
-  BackendOptions backend_options;
-  /// Visible channel slots of the page table and octree; 0 = the dataset's channel count,
-  /// capped at RESOCT_MAX_SLOTS (32).
-  std::uint32_t visible_slots = 0;
-  std::uint64_t device_cache_bytes = std::uint64_t(512) << 20;
-  /// Blocks of 16^3 page-table entries the sparse page table may allocate (16 KiB of device
-  /// memory each; docs/core-structures.md). 0 = derived: the device cache's slots plus half as
-  /// many again (at least 64) of headroom, clamped to the blocks of all tables. Must exceed the
-  /// cache slots (so that a block without MAPPED entries can always be reclaimed) unless it
-  /// covers every block, and stay below 2^19.
-  std::uint32_t page_pool_blocks = 0;
-  std::uint64_t host_cache_bytes = std::uint64_t(1) << 30;
-  UploadBudget upload_budget{256, std::numeric_limits<std::uint64_t>::max()};
-  std::uint32_t ttl = 2;         ///< frames a fresh upload stays pinned (>= 1)
-  std::string eviction = "lru";  ///< device cache: "lru" or "octreemizer"
-  /// Host cache (decoded bricks): "lru" or "octreemizer" (distance from the current camera).
-  std::string host_eviction = "lru";
-  PrefetchOptions prefetch;
-  glm::uvec3 leaf_size{16};  ///< residency octree leaf, voxels per axis
-  RenderMode mode = RenderMode::residency;
-  RequestStrategy strategy = RequestStrategy::greedy;
-  /// Bricks whose load failed with an error that may pass (a network or server fault, exhausted
-  /// host memory) are loaded again this long after the failure, then after twice as long each
-  /// time, up to 32 times (BrickLoader::set_transient_retry); each is still reported once, and a
-  /// frame is not converged while a retry is pending. 0 = a failed brick stays failed (its
-  /// coarser substitute is final). At most 3600000 (one hour).
-  std::uint32_t retry_failed_after_ms = 0;
-  /// Loader threads; 0 loads synchronously inside render_frame (deterministic).
-  std::uint32_t loader_threads = std::max(1u, std::thread::hardware_concurrency());
-  std::uint32_t brick_request_capacity = 1u << 16;
-  std::uint32_t node_request_capacity = 1u << 14;
-  /// Node metadata records (node x assigned slot) supplied per frame; bounds the host time per
-  /// frame (a procedural region_meta costs a few microseconds).
-  std::uint32_t max_node_answers = 16384;
-  std::uint32_t max_iterations = 1u << 20;  ///< march iterations per ray (cap)
-  std::uint32_t start_depth = 2;
-  /// Throws Error(invalid_argument) naming the field.
-  void validate() const;
-};
-
-/// One rendered frame.
+/// One rendered frame. A viewer keeps one and passes it to every render_frame(scene, report):
+/// the renderer then reuses its pixel buffers instead of allocating an image per frame.
 struct FrameReport {
+  std::uint32_t width = 0;  ///< the frame's size, whichever output it carries
+  std::uint32_t height = 0;
+  /// Float RGBA, straight alpha (ViewerOptions::output rgba32f or both; else empty).
   Image image;
+  /// 8-bit RGBA, 4 bytes per pixel, row 0 at the top, as Image::to_rgba8 (output rgba8 or both;
+  /// else empty).
+  std::vector<std::uint8_t> rgba8;
   /// True when the frame needed nothing it did not have: no brick or node requests other than
-  /// for bricks that failed to load (for good: no retry pending), no dropped requests, nothing
-  /// queued, loading or waiting.
+  /// for bricks that failed to load, no dropped requests, nothing queued, loading or waiting.
   bool converged = false;
   FrameStats stats;
   std::vector<LoadFailure> failures;  ///< bricks that failed to load, each reported once
@@ -121,9 +64,18 @@ struct SharedEye {
 /// source concurrently (BrickSource members are thread-safe).
 class Renderer {
  public:
-  /// Validates the options, creates the backend (Error(invalid_argument) naming "backend" if
-  /// unknown), builds the host structures and configures the backend. Throws Error naming
-  /// "source" when it is null, or as the structures' constructors do.
+  /// Renders with `backend` (resoct::cpu::make_backend(), resoct::vk::make_backend(), or an
+  /// application's own Backend); RendererOptions::backend and ::backend_options are ignored.
+  /// Validates the options, builds the host structures and configures the backend. Throws
+  /// Error(invalid_argument) naming "backend" when it is null, Error(unsupported) naming
+  /// "backend" when it was compiled against another kernel record layout
+  /// (Backend::kernel_layout_version()), Error naming "source" when the source is null, or as
+  /// the structures' constructors do. A ViewerOptions converts to RendererOptions.
+  Renderer(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
+           RendererOptions options = {});
+  /// Name-based creation, for the command-line tools: validates the options, then creates the
+  /// backend registered as RendererOptions::backend (Error(invalid_argument) naming "backend"
+  /// when it is unknown) and continues as the constructor above.
   Renderer(std::shared_ptr<const BrickSource> source, RendererOptions options = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -138,8 +90,12 @@ class Renderer {
   /// it is invalid for the volume (its `timepoint` past the source's) or has more channels than
   /// visible slots.
   FrameReport render_frame(const Scene& scene);
+  /// The same into `report`, whose pixel buffers are reused: after the first two frames of a size
+  /// no frame allocates image memory. Every field of `report` is overwritten. Unchanged when the
+  /// scene is rejected.
+  void render_frame(const Scene& scene, FrameReport& report);
   /// Renders until a frame reports converged or `max_frames` frames were rendered (>= 1).
-  ConvergeReport render_until_converged(const Scene& scene, std::uint32_t max_frames);
+  ConvergeReport render_until_converged(const Scene& scene, std::uint32_t max_frames = 1000);
 
   /// The timepoint the last frame showed (the source's own before the first frame).
   std::uint32_t timepoint() const noexcept { return timepoint_; }
@@ -168,7 +124,9 @@ class Renderer {
   std::uint64_t frame_index() const noexcept { return frame_; }
 
  private:
+  static std::unique_ptr<Backend> named_backend(const RendererOptions& options);
   const FrameTables& frame_tables(const Scene& scene);
+  void take_pixels(FrameReport& report);
   void assign_channels(const Scene& scene);
   void switch_timepoint(std::uint32_t t);
   /// Bricks of the next timepoint the scene's view may need, for PrefetchOptions::next_timepoint.

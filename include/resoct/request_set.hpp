@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "resoct/hierarchy.hpp"
@@ -85,6 +86,10 @@ enum class RequestStrategy : std::uint8_t {
   greedy,  ///< the target and every coarser level on the way up
   global,  ///< only the target
 };
+/// "greedy" / "global".
+const char* to_string(RequestStrategy s) noexcept;
+/// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
+RequestStrategy parse_request_strategy(std::string_view s, std::string_view parameter = "strategy");
 
 /// The brick at coarser level `level` that contains `brick` of level `from` (level >= from).
 /// Bricks of every level have the same core size and levels differ by powers of two per axis, so

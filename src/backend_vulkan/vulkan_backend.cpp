@@ -27,12 +27,19 @@ std::uint32_t log2_pow2(std::uint32_t v) {
 
 }  // namespace
 
+std::unique_ptr<Backend> make_backend(const BackendOptions& options) {
+  return std::make_unique<VulkanBackend>(options);
+}
+
+std::unique_ptr<Backend> make_backend(VkInstance instance, VkPhysicalDevice physical,
+                                      VkDevice device, std::uint32_t queue_family) {
+  return std::make_unique<VulkanBackend>(instance, physical, device, queue_family);
+}
+
 void register_backend() {
   static std::once_flag once;
   std::call_once(once, [] {
-    resoct::register_backend("vulkan", [](const BackendOptions& o) -> std::unique_ptr<Backend> {
-      return std::make_unique<VulkanBackend>(o);
-    });
+    resoct::register_backend("vulkan", [](const BackendOptions& o) { return vk::make_backend(o); });
   });
 }
 

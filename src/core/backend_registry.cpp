@@ -17,23 +17,6 @@ Registry& registry() {
 }
 }  // namespace
 
-const char* to_string(RenderMode m) noexcept {
-  switch (m) {
-    case RenderMode::residency: return "residency";
-    case RenderMode::pagetable: return "pagetable";
-    case RenderMode::octree: return "octree";
-  }
-  return "unknown";
-}
-
-RenderMode parse_render_mode(std::string_view s) {
-  if (s == "residency") return RenderMode::residency;
-  if (s == "pagetable") return RenderMode::pagetable;
-  if (s == "octree") return RenderMode::octree;
-  throw invalid_parameter("mode",
-                          "'" + std::string(s) + "' is not one of residency, pagetable, octree");
-}
-
 void register_backend(const std::string& name, BackendFactory factory) {
   Registry& r = registry();
   std::lock_guard lock(r.mutex);
@@ -57,8 +40,13 @@ std::unique_ptr<Backend> create_backend(std::string_view name, const BackendOpti
     if (it == r.factories.end()) {
       std::string known;
       for (const auto& [n, f] : r.factories) known += (known.empty() ? "" : ", ") + n;
+      // The usual cause is a backend library whose register_backend() was never called; a
+      // backend object (resoct::cpu::make_backend()) needs no registration at all.
       throw invalid_parameter("backend", "'" + std::string(name) + "' is not registered (known: " +
-                                             (known.empty() ? "none" : known) + ")");
+                                             (known.empty() ? "none" : known) +
+                                             "); call resoct::cpu::register_backend() (or "
+                                             "resoct::vk::register_backend()) first, or pass a "
+                                             "backend object to the Renderer");
     }
     factory = it->second;
   }

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "resoct/error.hpp"
 
@@ -102,6 +103,25 @@ CameraRays::CameraRays(const Camera& camera, const Viewport& viewport)
     footprint_base_ = camera.ortho_height / rows;
     footprint_slope_ = 0.0;
   }
+}
+
+Camera orbit(const Camera& camera, double degrees) {
+  if (!std::isfinite(degrees)) throw invalid_parameter("degrees", "must be finite");
+  const double len = glm::length(camera.up);
+  if (!finite3(camera.up) || !(len > 0.0)) {
+    throw invalid_parameter("camera.up", "must be a finite non-zero vector");
+  }
+  // Rotates the eye's offset from the target about the unit up axis: the part along the axis
+  // stays, the rest turns in the plane perpendicular to it. Written so that an axis-aligned up
+  // keeps that coordinate exactly (a turntable about +y never drifts in height).
+  const glm::dvec3 k = camera.up / len;
+  const glm::dvec3 v = camera.eye - camera.target;
+  const glm::dvec3 along = k * glm::dot(k, v);
+  const double a = glm::radians(degrees);
+  const glm::dvec3 rotated = along + (v - along) * std::cos(a) + glm::cross(k, v) * std::sin(a);
+  Camera out = camera;
+  out.eye = camera.target + rotated;
+  return out;
 }
 
 Ray CameraRays::ray(double x, double y) const {

@@ -4,6 +4,10 @@
 
 namespace resoct {
 
+double per_ray(std::uint64_t total, const BackendStats& stats) noexcept {
+  return stats.rays == 0 ? 0.0 : double(total) / double(stats.rays);
+}
+
 std::string format_frame_line(const FrameStats& s) {
   char buf[256];
   std::snprintf(buf, sizeof buf,

@@ -21,7 +21,13 @@ Image::Image(std::uint32_t width, std::uint32_t height, glm::vec4 fill)
 }
 
 std::vector<std::uint8_t> Image::to_rgba8() const {
-  std::vector<std::uint8_t> out(pixels_.size() * 4);
+  std::vector<std::uint8_t> out;
+  to_rgba8(out);
+  return out;
+}
+
+void Image::to_rgba8(std::vector<std::uint8_t>& out) const {
+  out.resize(pixels_.size() * 4);
   for (std::size_t i = 0; i < pixels_.size(); ++i) {
     for (int c = 0; c < 4; ++c) {
       const float v = pixels_[i][c];
@@ -30,7 +36,6 @@ std::vector<std::uint8_t> Image::to_rgba8() const {
       out[i * 4 + std::size_t(c)] = std::uint8_t(std::lround(clamped * 255.0f));
     }
   }
-  return out;
 }
 
 Image Image::from_rgba8(std::uint32_t width, std::uint32_t height,
@@ -49,14 +54,26 @@ Image Image::from_rgba8(std::uint32_t width, std::uint32_t height,
 
 void write_png(const Image& image, const std::string& path) {
   if (image.width() == 0) throw invalid_parameter("image", "is empty");
-  const std::vector<std::uint8_t> rgba = image.to_rgba8();
+  write_png(image.width(), image.height(), image.to_rgba8(), path);
+}
+
+void write_png(std::uint32_t width, std::uint32_t height, std::span<const std::uint8_t> rgba,
+               const std::string& path) {
+  if (width == 0 || height == 0 || width > 65536 || height > 65536) {
+    throw invalid_parameter("image size", "width and height must be in 1..65536");
+  }
+  if (rgba.size() != std::size_t(width) * height * 4u) {
+    throw invalid_parameter("rgba", std::to_string(rgba.size()) + " bytes for a " +
+                                        std::to_string(width) + "x" + std::to_string(height) +
+                                        " image (4 bytes per pixel expected)");
+  }
   // Encode in memory first: a PNG error then leaves nothing behind, and the file is written
   // through the same atomic writer as every other output.
   png_image png;
   std::memset(&png, 0, sizeof png);
   png.version = PNG_IMAGE_VERSION;
-  png.width = image.width();
-  png.height = image.height();
+  png.width = width;
+  png.height = height;
   png.format = PNG_FORMAT_RGBA;
   png_alloc_size_t size = 0;
   if (!png_image_write_to_memory(&png, nullptr, &size, 0, rgba.data(), 0, nullptr)) {

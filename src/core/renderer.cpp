@@ -58,33 +58,35 @@ std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
   return std::uint32_t(blocks);
 }
 
-std::unique_ptr<EvictionPolicy> make_policy(const std::string& name, const BrickHierarchy& h,
+// Options are validated before the policies are made, so `policy` is one of the two.
+std::unique_ptr<EvictionPolicy> make_policy(Eviction policy, const BrickHierarchy& h,
                                             const glm::dvec3* camera) {
-  if (name == "lru") return std::make_unique<LruPolicy>();
-  if (name == "octreemizer") {
-    // Distances in physical units from the camera of the frame being rendered.
-    return std::make_unique<OctreemizerPolicy>(
-        h.level_count(), OctreemizerWeights{},
-        [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
-  }
-  throw invalid_parameter("eviction", "'" + name + "' is not one of lru, octreemizer");
+  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
+  // Distances in physical units from the camera of the frame being rendered.
+  return std::make_unique<OctreemizerPolicy>(
+      h.level_count(), OctreemizerWeights{},
+      [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
 }
 
-std::unique_ptr<EvictionPolicy> make_host_policy(const std::string& name, const BrickHierarchy& h,
+std::unique_ptr<EvictionPolicy> make_host_policy(Eviction policy, const BrickHierarchy& h,
                                                  std::shared_ptr<SharedEye> eye) {
-  if (name == "lru") return std::make_unique<LruPolicy>();
-  if (name == "octreemizer") {
-    return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
-                                               [&h, eye](BrickKey key) {
-                                                 glm::dvec3 e;
-                                                 {
-                                                   std::lock_guard lock(eye->mutex);
-                                                   e = eye->eye;
-                                                 }
-                                                 return brick_camera_distance(h, key, e);
-                                               });
-  }
-  throw invalid_parameter("host_eviction", "'" + name + "' is not one of lru, octreemizer");
+  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
+  return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
+                                             [&h, eye](BrickKey key) {
+                                               glm::dvec3 e;
+                                               {
+                                                 std::lock_guard lock(eye->mutex);
+                                                 e = eye->eye;
+                                               }
+                                               return brick_camera_distance(h, key, e);
+                                             });
+}
+
+// Checked first, before any structure is built.
+RendererOptions validated(RendererOptions o, const Backend* backend) {
+  if (backend == nullptr) throw invalid_parameter("backend", "must not be null");
+  o.validate();
+  return o;
 }
 
 bool page_unmapped(std::uint32_t entry) {
@@ -93,47 +95,18 @@ bool page_unmapped(std::uint32_t entry) {
 
 }  // namespace
 
-void RendererOptions::validate() const {
-  if (backend.empty()) throw invalid_parameter("backend", "must not be empty");
-  if (visible_slots > kernel::RESOCT_MAX_SLOTS) {
-    throw invalid_parameter("visible_slots", "must be at most RESOCT_MAX_SLOTS (32)");
-  }
-  if (device_cache_bytes == 0) throw invalid_parameter("device_cache_bytes", "must be > 0");
-  if (upload_budget.max_bricks == 0 || upload_budget.max_bytes == 0) {
-    throw invalid_parameter("upload_budget", "bricks and bytes per frame must be > 0");
-  }
-  if (ttl == 0) throw invalid_parameter("ttl", "must be >= 1");
-  if (eviction != "lru" && eviction != "octreemizer") {
-    throw invalid_parameter("eviction", "'" + eviction + "' is not one of lru, octreemizer");
-  }
-  if (host_eviction != "lru" && host_eviction != "octreemizer") {
-    throw invalid_parameter("host_eviction",
-                            "'" + host_eviction + "' is not one of lru, octreemizer");
-  }
-  if (prefetch.lookahead_frames > 64) {
-    throw invalid_parameter("prefetch.lookahead_frames", "must be at most 64");
-  }
-  if ((prefetch.lookahead_frames > 0 || prefetch.next_timepoint) &&
-      (prefetch.max_bricks == 0 || prefetch.max_bytes == 0)) {
-    throw invalid_parameter("prefetch", "max_bricks and max_bytes must be > 0 when enabled");
-  }
-  if (loader_threads > 1024) throw invalid_parameter("loader_threads", "must be at most 1024");
-  if (retry_failed_after_ms > 3600000u) {
-    throw invalid_parameter("retry_failed_after_ms", "must be at most 3600000 (one hour)");
-  }
-  if (brick_request_capacity == 0 || brick_request_capacity > (1u << 28)) {
-    throw invalid_parameter("brick_request_capacity", "must be 1..2^28");
-  }
-  if (node_request_capacity == 0 || node_request_capacity > (1u << 28)) {
-    throw invalid_parameter("node_request_capacity", "must be 1..2^28");
-  }
-  if (max_node_answers == 0) throw invalid_parameter("max_node_answers", "must be > 0");
-  if (max_iterations == 0) throw invalid_parameter("max_iterations", "must be > 0");
+std::unique_ptr<Backend> Renderer::named_backend(const RendererOptions& options) {
+  options.validate();  // before creating a device for options that would be refused anyway
+  return create_backend(options.backend, options.backend_options);
 }
 
 Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions options)
+    : Renderer(std::move(source), named_backend(options), options) {}
+
+Renderer::Renderer(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
+                   RendererOptions options)
     : source_(std::move(source)),
-      options_((options.validate(), std::move(options))),
+      options_(validated(std::move(options), backend.get())),
       hierarchy_(checked_source(source_).hierarchy()),
       layout_(hierarchy_.volume().extent, options_.leaf_size),
       pages_(hierarchy_, slot_count_for(options_, *source_),
@@ -155,7 +128,7 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions op
   loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
   timepoint_ = source_->timepoint();
   timepoint_source_ = source_;
-  backend_ = create_backend(options_.backend, options_.backend_options);
+  backend_ = std::move(backend);
   config_.voxel_type = hierarchy_.volume().type;
   config_.padded_brick = hierarchy_.layout().padded_size();
   config_.cache_slots = cache_->slot_count();
@@ -520,6 +493,30 @@ const FrameTables& Renderer::frame_tables(const Scene& scene) {
 }
 
 FrameReport Renderer::render_frame(const Scene& scene) {
+  FrameReport report;
+  render_frame(scene, report);
+  return report;
+}
+
+void Renderer::take_pixels(FrameReport& report) {
+  const Image& rendered = result_.image;
+  report.width = rendered.width();
+  report.height = rendered.height();
+  if (options_.output == FrameOutput::rgba32f) {
+    report.rgba8.clear();
+  } else {
+    rendered.to_rgba8(report.rgba8);
+  }
+  if (options_.output == FrameOutput::rgba8) {
+    report.image = Image();  // the float pixels stay with the backend, which renders into them
+  } else {
+    // The backend renders the next frame into the report's previous buffer (backends reuse an
+    // image of the right size), so two buffers alternate instead of one being made per frame.
+    std::swap(report.image, result_.image);
+  }
+}
+
+void Renderer::render_frame(const Scene& scene, FrameReport& report) {
   const auto t_frame = Clock::now();
   scene.validate(hierarchy_.volume(), timepoints(), "scene");
   if (scene.channels.size() > channels_.slot_count()) {
@@ -537,7 +534,7 @@ FrameReport Renderer::render_frame(const Scene& scene) {
     host_camera_->eye = camera_;
   }
   loader_->host_cache().set_frame(frame_);
-  FrameReport report;
+  report.stats = FrameStats{};
   FrameStats& stats = report.stats;
   stats.frame_index = frame_;
 
@@ -583,10 +580,8 @@ FrameReport Renderer::render_frame(const Scene& scene) {
 
   report.converged =
       !outstanding && staged_.empty() && loader_->idle() && loader_->retries_pending() == 0;
-  report.image = std::move(result_.image);
-  result_.image = Image();
+  take_pixels(report);
   stats.ms_frame = ms_since(t_frame);
-  return report;
 }
 
 ConvergeReport Renderer::render_until_converged(const Scene& scene, std::uint32_t max_frames) {
@@ -594,7 +589,7 @@ ConvergeReport Renderer::render_until_converged(const Scene& scene, std::uint32_
   ConvergeReport out;
   std::vector<LoadFailure> failures;
   for (out.frames = 1;; ++out.frames) {
-    out.last = render_frame(scene);
+    render_frame(scene, out.last);
     failures.insert(failures.end(), out.last.failures.begin(), out.last.failures.end());
     out.converged = out.last.converged;
     if (out.converged || out.frames >= max_frames) break;

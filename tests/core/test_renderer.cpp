@@ -137,7 +137,8 @@ TEST(Renderer, RejectsBadOptionsAndScenes) {
   auto src = make_test_source();
   register_test_backend();
   RendererOptions o = test_options(16, 4);
-  o.eviction = "fifo";
+  EXPECT_RESOCT_ERROR(parse_eviction("fifo"), ErrorCode::invalid_argument, "eviction");
+  o.eviction = static_cast<Eviction>(7);
   EXPECT_RESOCT_ERROR(Renderer(src, o), ErrorCode::invalid_argument, "eviction");
   o = test_options(16, 4);
   o.ttl = 0;

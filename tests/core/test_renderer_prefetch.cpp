@@ -14,7 +14,7 @@ TEST(RendererPrefetch, MovingCameraFillsTheHostCacheOnly) {
   auto src = test::make_test_source(1);
   RendererOptions o = test::test_options(16, 64);
   o.loader_threads = 2;
-  o.host_eviction = "octreemizer";
+  o.host_eviction = Eviction::octreemizer;
   o.host_cache_bytes = 24 * (1000 + HostBrickCache::kEntryOverhead);  // room for 24 bricks
   o.prefetch.lookahead_frames = 3;
   o.prefetch.max_bricks = 16;

@@ -9,11 +9,11 @@ namespace {
 
 /// Runs `frames` frames with a cache of `cache_slots` (< the 32 varying level-0 bricks plus
 /// ancestors the scene needs) and checks pinning, progress and coverage.
-void run_small_cache(std::uint32_t ttl, std::string eviction) {
+void run_small_cache(std::uint32_t ttl, std::string_view eviction) {
   auto src = make_test_source();
   RendererOptions o = test_options(12, 256);
   o.ttl = ttl;
-  o.eviction = std::move(eviction);
+  o.eviction = parse_eviction(eviction);
   Rig rig(src, o);
   const Scene scene = test_scene(0);
   std::map<std::uint32_t, std::uint64_t> uploaded_at;  // cache slot -> frame of its last upload

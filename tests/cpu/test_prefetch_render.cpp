@@ -37,16 +37,6 @@ RendererOptions sync_options() {
   return o;
 }
 
-/// The camera orbiting the volume centre by `deg` degrees about the y axis.
-Camera orbit(const Camera& c, double deg) {
-  const double a = glm::radians(deg);
-  const glm::dvec3 d = c.eye - c.target;
-  Camera out = c;
-  out.eye = c.target + glm::dvec3(std::cos(a) * d.x + std::sin(a) * d.z, d.y,
-                                  -std::sin(a) * d.x + std::cos(a) * d.z);
-  return out;
-}
-
 }  // namespace
 
 TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
@@ -120,9 +110,11 @@ TEST(PrefetchRender, OptionsAreValidated) {
   o.prefetch.max_bricks = 0;
   EXPECT_RESOCT_ERROR(o.validate(), ErrorCode::invalid_argument, "prefetch");
   o = sync_options();
-  o.host_eviction = "fifo";
+  EXPECT_RESOCT_ERROR(parse_eviction("fifo", "host_eviction"), ErrorCode::invalid_argument,
+                      "host_eviction");
+  o.host_eviction = static_cast<Eviction>(7);  // what a bad cast from an integer gives
   EXPECT_RESOCT_ERROR(o.validate(), ErrorCode::invalid_argument, "host_eviction");
-  o.host_eviction = "octreemizer";
+  o.host_eviction = parse_eviction("octreemizer", "host_eviction");
   std::shared_ptr<const BrickSource> src = make_procedural_source("procedural:sphere:32x32x32");
   Renderer r(src, o);
   EXPECT_EQ(r.loader().stats().loads, 0u);

@@ -1,6 +1,6 @@
 // The interop constructor: the backend renders with an application's instance and device (here
 // created with the validation layer and a messenger of the test's own) and matches the CPU
-// backend like the self-created backend does.
+// backend like the self-created backend does, alone and as a Renderer's backend object.
 #include <atomic>
 #include <cstdio>
 #include <vector>
@@ -9,7 +9,9 @@
 
 #include "vulkan_test_util.hpp"
 #include "support/expect_error.hpp"
+#include "resoct/overview_scene.hpp"
 #include "resoct/procedural_source.hpp"
+#include "resoct/renderer.hpp"
 #include "resoct/scene.hpp"
 #include "support/vulkan_required.hpp"
 
@@ -27,8 +29,33 @@ VKAPI_ATTR VkBool32 VKAPI_CALL count_message(VkDebugUtilsMessageSeverityFlagBits
   return VK_FALSE;
 }
 
-TEST(VulkanInterop, RendersWithAnApplicationDevice) {
-  if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
+// An application's instance and device: the validation layer with synchronization validation and
+// a messenger of the test's own that counts every warning and error.
+struct AppDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger = nullptr;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  std::uint32_t family = 0;
+
+  AppDevice() = default;
+  AppDevice(const AppDevice&) = delete;
+  AppDevice& operator=(const AppDevice&) = delete;
+  ~AppDevice() { destroy(); }
+
+  void destroy() {
+    if (device != VK_NULL_HANDLE) vkDestroyDevice(device, nullptr);
+    if (messenger != VK_NULL_HANDLE) destroy_messenger(instance, messenger, nullptr);
+    if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+    device = VK_NULL_HANDLE;
+    messenger = VK_NULL_HANDLE;
+    instance = VK_NULL_HANDLE;
+  }
+};
+
+// Fills `d`; a failed step is a fatal failure of the calling test (check HasFatalFailure()).
+void create_app_device(AppDevice& d) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.apiVersion = VK_API_VERSION_1_2;
   const char* layer = "VK_LAYER_KHRONOS_validation";
@@ -47,8 +74,7 @@ TEST(VulkanInterop, RendersWithAnApplicationDevice) {
   ici.ppEnabledLayerNames = &layer;
   ici.enabledExtensionCount = 2;
   ici.ppEnabledExtensionNames = ext;
-  VkInstance instance = VK_NULL_HANDLE;
-  ASSERT_EQ(vkCreateInstance(&ici, nullptr, &instance), VK_SUCCESS);
+  ASSERT_EQ(vkCreateInstance(&ici, nullptr, &d.instance), VK_SUCCESS);
   VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
                         VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
@@ -56,60 +82,98 @@ TEST(VulkanInterop, RendersWithAnApplicationDevice) {
       VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
   mci.pfnUserCallback = count_message;
   auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
-  auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+      vkGetInstanceProcAddr(d.instance, "vkCreateDebugUtilsMessengerEXT"));
+  d.destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(d.instance, "vkDestroyDebugUtilsMessengerEXT"));
   ASSERT_NE(create_messenger, nullptr);
-  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-  ASSERT_EQ(create_messenger(instance, &mci, nullptr, &messenger), VK_SUCCESS);
+  ASSERT_EQ(create_messenger(d.instance, &mci, nullptr, &d.messenger), VK_SUCCESS);
 
   std::uint32_t count = 1;
-  VkPhysicalDevice physical = VK_NULL_HANDLE;
-  vkEnumeratePhysicalDevices(instance, &count, &physical);
-  ASSERT_NE(physical, VK_NULL_HANDLE);
+  vkEnumeratePhysicalDevices(d.instance, &count, &d.physical);
+  ASSERT_NE(d.physical, VK_NULL_HANDLE);
   std::uint32_t qn = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(physical, &qn, nullptr);
+  vkGetPhysicalDeviceQueueFamilyProperties(d.physical, &qn, nullptr);
   std::vector<VkQueueFamilyProperties> q(qn);
-  vkGetPhysicalDeviceQueueFamilyProperties(physical, &qn, q.data());
-  std::uint32_t family = 0;
-  while (family < qn && (q[family].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) ++family;
-  ASSERT_LT(family, qn);
+  vkGetPhysicalDeviceQueueFamilyProperties(d.physical, &qn, q.data());
+  while (d.family < qn && (q[d.family].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) ++d.family;
+  ASSERT_LT(d.family, qn);
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  qci.queueFamilyIndex = family;
+  qci.queueFamilyIndex = d.family;
   qci.queueCount = 1;
   qci.pQueuePriorities = &priority;
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   dci.queueCreateInfoCount = 1;
   dci.pQueueCreateInfos = &qci;
-  VkDevice device = VK_NULL_HANDLE;
-  ASSERT_EQ(vkCreateDevice(physical, &dci, nullptr, &device), VK_SUCCESS);
-
-  {
-    vk::VulkanBackend gpu(instance, physical, device, family);
-    BrickLayout bl;
-    bl.brick_size = glm::uvec3(8);
-    bl.halo = 1;
-    ProceduralSource src("procedural:sphere:24x24x24", bl);
-    Scene scene = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/sphere.json");
-    scene.viewport = Viewport{24, 20};
-    ResidentScene rs(src, {0});
-    cpu::CpuBackend cpu(1);
-    OracleDiff d;
-    const FrameResult a = render_on(cpu, rs, scene, {});
-    const FrameResult b = render_on(gpu, rs, scene, {});
-    EXPECT_GT(a.stats.samples, 0u);
-    expect_same_frame(a, b, "interop sphere", d);
-  }
-  // The backend must not have destroyed the caller's handles.
-  EXPECT_EQ(vkDeviceWaitIdle(device), VK_SUCCESS);
-  vkDestroyDevice(device, nullptr);
-  destroy_messenger(instance, messenger, nullptr);
-  vkDestroyInstance(instance, nullptr);
-  EXPECT_EQ(g_messages.load(), 0);
+  ASSERT_EQ(vkCreateDevice(d.physical, &dci, nullptr, &d.device), VK_SUCCESS);
 }
 
-TEST(VulkanInterop, NullHandlesAreRejected) {
+// Tests that render on an application's device open it first; TearDown then checks that the
+// backend left the caller's handles usable and the validation layer silent.
+class VulkanInterop : public ::testing::Test {
+ protected:
+  /// Creates app_, or skips (fails with RESOCT_REQUIRE_VULKAN=1) without a device; the caller
+  /// returns when IsSkipped() or HasFatalFailure().
+  void open_device() {
+    if (vk::list_devices().empty()) RESOCT_SKIP_WITHOUT_VULKAN("no Vulkan device on this machine");
+    g_messages = 0;
+    create_app_device(app_);
+  }
+
+  void TearDown() override {
+    if (app_.device == VK_NULL_HANDLE) return;
+    EXPECT_EQ(vkDeviceWaitIdle(app_.device), VK_SUCCESS);
+    app_.destroy();
+    EXPECT_EQ(g_messages.load(), 0);
+  }
+
+  AppDevice app_;
+};
+
+TEST_F(VulkanInterop, RendersWithAnApplicationDevice) {
+  open_device();
+  if (IsSkipped() || HasFatalFailure()) return;
+  vk::VulkanBackend gpu(app_.instance, app_.physical, app_.device, app_.family);
+  BrickLayout bl;
+  bl.brick_size = glm::uvec3(8);
+  bl.halo = 1;
+  ProceduralSource src("procedural:sphere:24x24x24", bl);
+  Scene scene = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/sphere.json");
+  scene.viewport = Viewport{24, 20};
+  ResidentScene rs(src, {0});
+  cpu::CpuBackend cpu(1);
+  OracleDiff d;
+  const FrameResult a = render_on(cpu, rs, scene, {});
+  const FrameResult b = render_on(gpu, rs, scene, {});
+  EXPECT_GT(a.stats.samples, 0u);
+  expect_same_frame(a, b, "interop sphere", d);
+}
+
+// The interop form as a backend object: a Renderer drives the application's device through the
+// whole frame loop (configure, uploads, requests) and converges to the CPU renderer's image.
+TEST_F(VulkanInterop, RendererTakesAnApplicationDeviceBackend) {
+  open_device();
+  if (IsSkipped() || HasFatalFailure()) return;
+  const std::shared_ptr<const BrickSource> src =
+      make_procedural_source("procedural:tubes:48x48x48", BrickLayout{glm::uvec3(16), 1});
+  const Scene scene = overview_scene(src->hierarchy().volume(), Viewport{40, 32});
+  ViewerOptions o;
+  o.loader_threads = 0;
+  Renderer on_gpu(src, vk::make_backend(app_.instance, app_.physical, app_.device, app_.family), o);
+  Renderer on_cpu(src, cpu::make_backend(1), o);
+  EXPECT_EQ(on_gpu.backend().name(), "vulkan");
+  const ConvergeReport a = on_cpu.render_until_converged(scene, 64);
+  const ConvergeReport b = on_gpu.render_until_converged(scene, 64);
+  ASSERT_TRUE(a.converged);
+  ASSERT_TRUE(b.converged);
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_GT(a.last.stats.backend.samples, 0u);
+  EXPECT_EQ(a.last.stats.backend.samples, b.last.stats.backend.samples);
+  const ImageDiff diff = compare_images(a.last.image, b.last.image);
+  for (int c = 0; c < 4; ++c) EXPECT_LE(diff.max_abs[c], kVulkanColourTolerance) << c;
+}
+
+TEST_F(VulkanInterop, NullHandlesAreRejected) {
   EXPECT_RESOCT_ERROR(vk::VulkanBackend(VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, 0),
                       ErrorCode::invalid_argument, "device");
 }

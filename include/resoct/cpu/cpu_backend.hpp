@@ -14,8 +14,13 @@
 
 namespace resoct::cpu {
 
-/// Registers the CPU backend under the name "cpu" (idempotent, thread-safe). Call it before
-/// create_backend("cpu"): static initializers in shared libraries are unreliable.
+/// A CPU backend object for Renderer(source, backend, options): the way a viewer makes one (no
+/// registration needed). `threads` <= 0: OpenMP's default thread count.
+std::unique_ptr<Backend> make_backend(int threads = 0);
+
+/// Registers the CPU backend under the name "cpu" (idempotent, thread-safe), for name-based
+/// creation (create_backend("cpu"), RendererOptions::backend). Call it before: static
+/// initializers in shared libraries are unreliable.
 void register_backend();
 
 /// Device state in host memory. Not thread-safe (one Renderer drives it). Renders of different

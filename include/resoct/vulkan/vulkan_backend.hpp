@@ -21,8 +21,18 @@
 
 namespace resoct::vk {
 
-/// Registers the backend under the name "vulkan" (idempotent, thread-safe). The factory honours
-/// BackendOptions::device and ::validation.
+/// A Vulkan backend object with its own instance and device, for Renderer(source, backend,
+/// options): see VulkanBackend(const BackendOptions&) for `options` and the errors.
+std::unique_ptr<Backend> make_backend(const BackendOptions& options = {});
+/// A Vulkan backend object on an application's instance and device (the interop constructor
+/// VulkanBackend(instance, physical, device, queue_family); the handles stay the caller's and
+/// must outlive the Renderer).
+std::unique_ptr<Backend> make_backend(VkInstance instance, VkPhysicalDevice physical,
+                                      VkDevice device, std::uint32_t queue_family);
+
+/// Registers the backend under the name "vulkan" (idempotent, thread-safe), for name-based
+/// creation (RendererOptions::backend). The factory honours BackendOptions::device and
+/// ::validation.
 void register_backend();
 
 /// Device arrays a test can read back (debug_read()).

@@ -1,0 +1,11 @@
+#pragma once
+// A frame's statistics as a Python dict (resoct.Frame.stats).
+
+#include "bindings.hpp"
+#include "resoct/frame_stats.hpp"
+
+namespace resoct::python {
+
+py::dict stats_dict(const FrameStats& stats);
+
+}  // namespace resoct::python

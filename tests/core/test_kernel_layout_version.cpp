@@ -1,0 +1,49 @@
+// What RESOCT_KERNEL_LAYOUT_VERSION 1 means: the sizes of the records the host shares with the
+// device and the encodings of their packed words. A change to any of them fails here until the
+// version is incremented and this table updated (kernel/layout_version.glsl.h), so applications
+// and backends built against another layout can tell.
+#include <gtest/gtest.h>
+
+#include "resoct/kernel/frame.glsl.h"
+#include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/kernel/page_entry.glsl.h"
+#include "resoct/kernel/request_key.glsl.h"
+#include "resoct/page_table.hpp"
+#include "resoct/residency_octree.hpp"
+#include "resoct/transfer_function.hpp"
+#include "resoct/version.hpp"
+
+namespace resoct::test {
+namespace {
+
+namespace k = resoct::kernel;
+
+TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
+  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 1u)
+      << "the layout version changed: update the table of this test to the new layout";
+  const char* bump = "a shared record changed: increment RESOCT_KERNEL_LAYOUT_VERSION";
+  EXPECT_EQ(sizeof(k::ResoctFrame), 500u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctFxFrame), 44u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctSlotInfo), 64u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctLevelInfo), 40u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctDepthInfo), 56u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctRayStats), 40u) << bump;
+  EXPECT_EQ(sizeof(PageDelta), 8u) << bump;
+  EXPECT_EQ(sizeof(OctreeWordDelta), 8u) << bump;
+  EXPECT_EQ(k::RESOCT_PAGE_STATE_SHIFT, 30u) << bump;
+  EXPECT_EQ(k::RESOCT_PAGE_STATE_HOMOGENEOUS, 3u) << bump;
+  EXPECT_EQ(k::RESOCT_NODE_WORDS, 4u) << bump;
+  EXPECT_EQ(k::RESOCT_NODE_FLAGS, 3u) << bump;
+  EXPECT_EQ(k::RESOCT_REQUEST_IN_BLOCK_BITS, 12u) << bump;
+  EXPECT_EQ(k::RESOCT_REQUEST_BLOCK_MISS_BIT, 0x80000000u) << bump;
+  EXPECT_EQ(kTfLutSize, 1024u) << bump;  // RESOCT_TF_LUT_SIZE (tf.glsl.h is not standalone)
+  EXPECT_EQ(k::RESOCT_MAX_SLOTS, 32u) << bump;
+}
+
+TEST(KernelLayoutVersion, TheLibraryWasBuiltWithTheseHeaders) {
+  EXPECT_EQ(library_kernel_layout_version(), kKernelLayoutVersion);
+  EXPECT_EQ(kKernelLayoutVersion, k::RESOCT_KERNEL_LAYOUT_VERSION);
+}
+
+}  // namespace
+}  // namespace resoct::test
