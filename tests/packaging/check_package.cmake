@@ -1,6 +1,7 @@
 # Packaging check, run by ctest: install resoct into a fresh prefix, then configure, build and run
 # examples/from_install against (1) the install tree and (2) the build tree.
-# Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "cpu;vulkan")
+# Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "cpu;vulkan");
+# optional -DCONSUMER_CXX_COMPILER and -DCONSUMER_CXX_FLAGS, resoct's own, for the consumer.
 foreach(v SOURCE_DIR BINARY_DIR WORK_DIR COMPONENTS)
   if(NOT DEFINED ${v})
     message(FATAL_ERROR "check_package.cmake: -D${v}= is required")
@@ -25,6 +26,13 @@ foreach(f include/resoct/hierarchy.hpp lib/cmake/resoct/resoctConfig.cmake
 endforeach()
 
 string(REPLACE ";" "\\;" comps "${COMPONENTS}")
+set(toolchain)
+if(CONSUMER_CXX_COMPILER)
+  list(APPEND toolchain -DCMAKE_CXX_COMPILER=${CONSUMER_CXX_COMPILER})
+endif()
+if(CONSUMER_CXX_FLAGS)
+  list(APPEND toolchain "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}")
+endif()
 foreach(kind install build)
   if(kind STREQUAL "install")
     set(locate -DCMAKE_PREFIX_PATH=${prefix})
@@ -33,7 +41,7 @@ foreach(kind install build)
   endif()
   set(bdir ${WORK_DIR}/consumer-${kind})
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/from_install -B ${bdir} -G Ninja
-      -DCMAKE_BUILD_TYPE=Release ${locate} "-DRESOCT_CONSUMER_COMPONENTS=${comps}")
+      -DCMAKE_BUILD_TYPE=Release ${locate} "-DRESOCT_CONSUMER_COMPONENTS=${comps}" ${toolchain})
   run(${CMAKE_COMMAND} --build ${bdir})
   run(${bdir}/consumer)
   message(STATUS "consumer against the ${kind} tree: ok")
