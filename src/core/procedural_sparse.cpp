@@ -25,9 +25,20 @@ void grid_bounds(std::span<const double> xs, std::span<const double> ys, std::sp
   mm(zs, lo.z, hi.z);
 }
 
+// A point uniform in the box [lo, hi), drawn z, then y, then x. The draws are separate
+// statements because C++ leaves the order of a call's arguments unspecified (g++ evaluates
+// them right to left, clang left to right), and the field must not depend on the compiler;
+// z, y, x is g++'s order, which every committed result and tolerance was measured with.
+glm::dvec3 uniform_point(Rng& rng, const glm::dvec3& lo, const glm::dvec3& hi) {
+  const double z = rng.uniform(lo.z, hi.z);
+  const double y = rng.uniform(lo.y, hi.y);
+  const double x = rng.uniform(lo.x, hi.x);
+  return {x, y, z};
+}
+
 glm::dvec3 random_unit(Rng& rng) {
   for (;;) {
-    const glm::dvec3 v(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    const glm::dvec3 v = uniform_point(rng, glm::dvec3(-1), glm::dvec3(1));
     const double l = glm::length(v);
     if (l > 0.1 && l <= 1.0) return v / l;
   }
@@ -53,8 +64,10 @@ class TubesField final : public Field {
       Rng rng(0x7b1e5ull + 1000003ull * c);
       std::vector<Segment> segs;
       for (int root = 0; root < 3; ++root) {
-        const glm::dvec3 p(rng.uniform(0.3, 0.7) * qext.x, rng.uniform(0.3, 0.7) * qext.y,
-                           0.05 * qext.z);
+        // Two draws, y then x (g++'s order, see uniform_point); the roots start near z = 0.
+        const double y = rng.uniform(0.3, 0.7);
+        const double x = rng.uniform(0.3, 0.7);
+        const glm::dvec3 p = glm::dvec3(x, y, 0.05) * qext;
         const glm::dvec3 dir = glm::normalize(glm::dvec3(0, 0, 1) + 0.3 * random_unit(rng));
         grow(rng, qext, p, dir, 0.22, 0.018, 5, segs);
       }
@@ -173,8 +186,7 @@ class NoiseFloorField final : public Field {
       double lip = kFloorAmp * kValueNoiseLipschitz * scale_;
       for (int k = 0; k < 48; ++k) {
         Blob b;
-        b.centre = glm::dvec3(rng.uniform(0.1, 0.9), rng.uniform(0.1, 0.9), rng.uniform(0.1, 0.9)) *
-                   qext * m;
+        b.centre = uniform_point(rng, glm::dvec3(0.1), glm::dvec3(0.9)) * qext * m;
         b.radius = rng.uniform(0.02, 0.06) * m;
         b.intensity = rng.uniform(0.4, 1.0);
         lip = std::max(lip, b.intensity * kBumpSlope / b.radius);

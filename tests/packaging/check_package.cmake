@@ -4,7 +4,8 @@
 # C++ snippet. With -DPYTHON, the README's Python snippet (examples/python/render_frame.py) runs
 # with the module installed into <prefix>/PYTHON_DIR.
 # Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "cpu;vulkan"),
-# optionally -DPYTHON (interpreter) -DPYTHON_DIR (module directory below the prefix)
+# optionally -DPYTHON (interpreter) -DPYTHON_DIR (module directory below the prefix), and
+# -DCONSUMER_CXX_COMPILER and -DCONSUMER_CXX_FLAGS, resoct's own, for the consumer.
 foreach(v SOURCE_DIR BINARY_DIR WORK_DIR COMPONENTS)
   if(NOT DEFINED ${v})
     message(FATAL_ERROR "check_package.cmake: -D${v}= is required")
@@ -30,6 +31,13 @@ foreach(f include/resoct/hierarchy.hpp include/resoct/version.hpp
 endforeach()
 
 string(REPLACE ";" "\\;" comps "${COMPONENTS}")
+set(toolchain)
+if(CONSUMER_CXX_COMPILER)
+  list(APPEND toolchain -DCMAKE_CXX_COMPILER=${CONSUMER_CXX_COMPILER})
+endif()
+if(CONSUMER_CXX_FLAGS)
+  list(APPEND toolchain "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}")
+endif()
 foreach(kind install build)
   if(kind STREQUAL "install")
     set(locate -DCMAKE_PREFIX_PATH=${prefix})
@@ -39,7 +47,7 @@ foreach(kind install build)
   set(bdir ${WORK_DIR}/consumer-${kind})
   run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/from_install -B ${bdir} -G Ninja
       -DCMAKE_BUILD_TYPE=Release ${locate} "-DRESOCT_CONSUMER_COMPONENTS=${comps}"
-      -DRESOCT_API_EXAMPLES_DIR=${SOURCE_DIR}/examples)
+      -DRESOCT_API_EXAMPLES_DIR=${SOURCE_DIR}/examples ${toolchain})
   run(${CMAKE_COMMAND} --build ${bdir})
   run(${bdir}/consumer)
   execute_process(COMMAND ${bdir}/example_02_render_frame

@@ -14,6 +14,7 @@
 
 #include "core/test_brick_store_util.hpp"
 #include "support/generated_data.hpp"
+#include "support/sanitized.hpp"
 #include "support/tool_process.hpp"
 
 using resoct::test::shell_quote;
@@ -149,7 +150,7 @@ TEST_F(ToolExitCodes, ConvertSuccessIs0AndReplacesTheOldStore) {
 }
 
 TEST_F(ToolExitCodes, ConvertOutOfMemoryIs3) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if RESOCT_TEST_SANITIZED
   GTEST_SKIP() << "sanitizer runtimes reserve more address space than the limit allows";
 #endif
   // Anything but a resoct::Error or a usage error: here std::bad_alloc, from an address space

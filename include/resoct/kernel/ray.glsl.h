@@ -57,11 +57,22 @@ RESOCT_FN bool resoct_ray_hits(vec2 interval, float t_min) {
   return max(interval.x, t_min) < interval.y;
 }
 
+/// a - b as a float, rounded once, for any two ints. The difference is taken in unsigned
+/// arithmetic: a signed a - b overflows when the box is unclipped (a corner of -(2^31 - 1),
+/// traverse.glsl.h), which is undefined behaviour in C++ and wraps to the wrong sign in GLSL.
+/// Where a - b fits an int the result equals float(a - b), bit for bit (rounding is symmetric).
+RESOCT_FN float resoct_int_difference(int a, int b) {
+  return a >= b ? float(uint(a) - uint(b)) : -float(uint(b) - uint(a));
+}
+
 /// Ray origin relative to a node's lower corner, in level-0 voxels. The origin is given split
 /// into an exact integer voxel `origin_cell` and a fraction `origin_frac` (any float, normally in
 /// [0, 1)); the integer subtraction is exact for any volume below 2^31 voxels per axis.
 RESOCT_FN vec3 resoct_relative_origin(ivec3 origin_cell, vec3 origin_frac, ivec3 node_lo) {
-  return vec3(origin_cell - node_lo) + origin_frac;
+  return vec3(resoct_int_difference(origin_cell.x, node_lo.x),
+              resoct_int_difference(origin_cell.y, node_lo.y),
+              resoct_int_difference(origin_cell.z, node_lo.z)) +
+         origin_frac;
 }
 
 /// Entry and exit with a node in node-local coordinates: the node is [0, node_size) and the
