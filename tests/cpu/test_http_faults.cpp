@@ -31,16 +31,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Client options for the fault run: every attempt ends within a second (a stall lasts 3 s), one
-// retry inside the store, a Retry-After capped at 40 ms. The loader's retries do the rest.
+// Client options for the fault run: the tests' fast options, with every attempt ending within a
+// second (a stall lasts 3 s) and one retry inside the store. The loader's retries do the rest.
 HttpOptions fault_http_options() {
-  HttpOptions o;
+  HttpOptions o = test::fast_http_options();
   o.connect_timeout_ms = 500;
   o.total_timeout_ms = 1000;
-  o.low_speed_time_s = 1;
   o.retries = 1;
-  o.backoff_initial_ms = 10;
-  o.backoff_max_ms = 40;
   return o;
 }
 
