@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages resoct needs to build, test and benchmark. Idempotent: when every
-# package is already present it does nothing (and needs no network). Runs as root, or via sudo.
+# Installs the Debian 12 packages resoct needs to build, test (sanitizer stages included) and
+# benchmark. Idempotent: when every package is already present it does nothing (and needs no
+# network). Runs as root, or via sudo.
 set -euo pipefail
 
 PACKAGES=(
@@ -15,6 +16,9 @@ PACKAGES=(
   python3-zarr python3-numcodecs python3-numpy mricron-data
   # HTTP tests and bench_http: /usr/bin/python3 runs tests/support/http_test_server.py
   python3
+  # Sanitizer stages (scripts/sanitize.sh) and the fuzzers: clang, its sanitizer runtimes,
+  # llvm-symbolizer for the reports; libomp-dev above brings LLVM's libomp and Archer (TSan)
+  clang libclang-rt-14-dev llvm
 )
 
 missing=()
