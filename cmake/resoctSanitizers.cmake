@@ -1,10 +1,12 @@
 # RESOCT_SANITIZE: a sanitizer build of everything (the asan and tsan presets, which
 # scripts/sanitize.sh builds and tests; docs/testing.md "Sanitizers"). Included before any target
-# is defined, so that resoct's libraries are instrumented, not only the tests.
-#   address: AddressSanitizer + LeakSanitizer + UndefinedBehaviorSanitizer (any compiler)
-#   thread:  ThreadSanitizer (clang: its OpenMP runtime, LLVM libomp, tells TSan about its
-#            barriers through the Archer tool; g++'s libgomp is not instrumented, so TSan would
-#            see every hand-over between OpenMP threads as a race)
+# is defined, so that resoct's libraries are instrumented, not only the tests. Clang only: its
+# runtimes are linked into each executable (g++'s libasan must come first in the library list,
+# before the helper the asan tests preload), and its OpenMP runtime, LLVM's libomp, tells TSan
+# about its barriers through the Archer tool (g++'s libgomp is not instrumented, so TSan would
+# see every hand-over between OpenMP threads as a race).
+#   address: AddressSanitizer + LeakSanitizer + UndefinedBehaviorSanitizer
+#   thread:  ThreadSanitizer
 # Besides the flags, this writes what the test processes need into a file ctest reads before it
 # runs any test (TEST_INCLUDE_FILES): the runtime options, and the paths of the helpers below.
 set(RESOCT_SANITIZE "" CACHE STRING "Sanitizer build: address (ASan + UBSan) or thread (TSan)")
@@ -16,6 +18,9 @@ endif()
 if(RESOCT_BUILD_FUZZ)
   message(FATAL_ERROR "RESOCT_SANITIZE and RESOCT_BUILD_FUZZ are separate builds (presets asan, "
                       "tsan and fuzz)")
+endif()
+if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "RESOCT_SANITIZE needs clang (the asan and tsan presets)")
 endif()
 
 # Every sanitizer message goes to a file <prefix>.<pid> here, whichever process printed it (a tool
@@ -51,9 +56,6 @@ if(RESOCT_SANITIZE STREQUAL "address")
            "set(ENV{LD_PRELOAD} \"$<TARGET_FILE:resoct_keep_modules_loaded>\")\n")
   endif()
 elseif(RESOCT_SANITIZE STREQUAL "thread")
-  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-    message(FATAL_ERROR "RESOCT_SANITIZE=thread needs clang and LLVM's libomp (the tsan preset)")
-  endif()
   set(RESOCT_SANITIZE_FLAGS -fsanitize=thread)
   # Archer, LLVM's OMPT tool for TSan, ships next to libomp (Debian: libomp-14-dev). libomp loads
   # it from OMP_TOOL_LIBRARIES; without it TSan misses the OpenMP barriers and reductions.
@@ -64,8 +66,16 @@ elseif(RESOCT_SANITIZE STREQUAL "thread")
                         "(${OpenMP_omp_LIBRARY}); Debian: apt install libomp-14-dev")
   endif()
   # abort_on_error as for ASan; second_deadlock_stack for lock-order reports.
-  set(_tsan "halt_on_error=1:abort_on_error=1:second_deadlock_stack=1:log_path=${_reports_prefix}")
-  string(APPEND _env "set(ENV{TSAN_OPTIONS} \"${_tsan}:\$ENV{TSAN_OPTIONS}\")\n"
+  # ignore_noninstrumented_modules: libomp is not instrumented either, and its threads hand
+  # over through atomics TSan cannot see, so the calls it makes into TSan's interceptors (mutex
+  # set-up, memset of its own buffers) look like races; Archer asks for this setting and warns on
+  # every process's stderr without it. It ignores the interceptor calls of every uninstrumented
+  # library, not only libomp's: docs/testing.md "Sanitizers" shows that the narrower
+  # called_from_lib:libomp.so.5 finds no more. Separated by spaces: Archer reads the variable
+  # split at spaces only.
+  string(CONCAT _tsan "halt_on_error=1 abort_on_error=1 second_deadlock_stack=1"
+                      " ignore_noninstrumented_modules=1 log_path=${_reports_prefix}")
+  string(APPEND _env "set(ENV{TSAN_OPTIONS} \"${_tsan} \$ENV{TSAN_OPTIONS}\")\n"
                      "set(ENV{OMP_TOOL_LIBRARIES} \"${RESOCT_ARCHER_LIBRARY}\")\n")
 else()
   message(FATAL_ERROR "RESOCT_SANITIZE must be empty, address or thread, not ${RESOCT_SANITIZE}")

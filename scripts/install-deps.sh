@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages resoct needs to build, test and benchmark. Idempotent: when every
-# package is already present it does nothing (and needs no network). Runs as root, or via sudo.
+# Installs the Debian 12 packages resoct needs to build, test (sanitizer stages included) and
+# benchmark. Idempotent: when every package is already present it does nothing (and needs no
+# network). Runs as root, or via sudo.
 set -euo pipefail
 
 PACKAGES=(
@@ -17,6 +18,9 @@ PACKAGES=(
   python3
   # the Python module (python/) and its tests: pybind11 and the headers of Debian's python3
   pybind11-dev python3-dev
+  # Sanitizer stages (scripts/sanitize.sh) and the fuzzers: clang, its sanitizer runtimes,
+  # llvm-symbolizer for the reports; libomp-dev above brings LLVM's libomp and Archer (TSan)
+  clang libclang-rt-14-dev llvm
 )
 
 missing=()

@@ -1,5 +1,5 @@
-// Preloaded into every test process of the asan preset (LD_PRELOAD, CMakePresets.json): dlclose()
-// does nothing, so no module is ever unloaded.
+// Preloaded into every test process of the asan preset (LD_PRELOAD, set by
+// cmake/resoctSanitizers.cmake): dlclose() does nothing, so no module is ever unloaded.
 //
 // Why: the Vulkan loader unloads the driver (Mesa's lavapipe, with LLVM) and the validation layer
 // in vkDestroyInstance. Memory those modules keep in their own globals (lavapipe's once-per-process
