@@ -7,7 +7,7 @@
 #include <numeric>
 #include <random>
 
-#include "resoct/brick_cache.hpp"
+#include "resoct/engine/brick_cache.hpp"
 
 namespace {
 

@@ -15,11 +15,11 @@
 
 #include <unistd.h>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/http_store.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/random_access_file.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/http/http_store.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/base/random_access_file.hpp"
 #include "support/http_test_server.hpp"
 
 using namespace resoct;

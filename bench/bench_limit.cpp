@@ -54,10 +54,10 @@
 #include <string>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/frame_tables.hpp"
-#include "resoct/image.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/frame_tables.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/bench_rig.hpp"
 #include "support/dense_march.hpp"
 

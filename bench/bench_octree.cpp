@@ -22,7 +22,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "resoct/residency_octree.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace {
 

@@ -38,8 +38,8 @@
 #include <string>
 #include <vector>
 
-#include "resoct/dense_volume.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 #include "support/bench_rig.hpp"
 #include "support/converge_run.hpp"
 #include "support/duplicate_source.hpp"

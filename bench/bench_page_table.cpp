@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include "resoct/page_table.hpp"
+#include "resoct/engine/page_table.hpp"
 
 namespace {
 

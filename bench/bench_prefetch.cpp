@@ -20,10 +20,10 @@
 #include <thread>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
 #include "support/loading_bench.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 
 using namespace resoct;
 

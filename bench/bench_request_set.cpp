@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "resoct/request_set.hpp"
+#include "resoct/engine/request_set.hpp"
 
 namespace {
 

@@ -21,7 +21,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "resoct/renderer.hpp"
+#include "resoct/render/renderer.hpp"
 #include "support/bench_rig.hpp"
 
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "resoct/in_memory_source.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 using namespace resoct;
 

@@ -15,8 +15,8 @@
 
 #include <unistd.h>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 using namespace resoct;
 

@@ -26,10 +26,10 @@
 #include <vector>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
 #include "support/loading_bench.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 
 using namespace resoct;
 

@@ -24,11 +24,11 @@
 
 #include <benchmark/benchmark.h>
 
-#include "resoct/channel_map.hpp"
+#include "resoct/engine/channel_map.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/frame_tables.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/residency_octree.hpp"
+#include "resoct/render/frame_tables.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace {
 

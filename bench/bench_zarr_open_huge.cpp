@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "resoct/formats/ome_zarr.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
 
 namespace {
 

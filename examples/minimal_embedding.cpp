@@ -1,8 +1,8 @@
 // The README's embedding example, built and run by ctest so that it cannot rot.
 #include <cstdio>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/open_source.hpp"
 
 int main() {
   // Any brick source: a procedural volume, an in-memory one, or a brick store file.

@@ -19,13 +19,13 @@
 
 #include <CLI/CLI.hpp>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/codec.hpp"
-#include "resoct/error.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/raw_volume.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/storage/codec.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/io/formats/raw_volume.hpp"
 #include "support/cli_parse.hpp"
 #include "support/output_path.hpp"
 #include "support/progress.hpp"

@@ -9,8 +9,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/cli_parse.hpp"
 #include "support/source_options.hpp"
 #include "support/tool_main.hpp"

@@ -14,11 +14,11 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/cli_parse.hpp"
 #include "support/source_options.hpp"
 #include "support/output_path.hpp"

@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/checksum.hpp"
-#include "resoct/store/format.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/storage/checksum.hpp"
+#include "resoct/io/store/format.hpp"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <span>
 
 #include "fuzz_support.hpp"
-#include "resoct/formats/nifti.hpp"
+#include "resoct/io/formats/nifti.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace resoct;

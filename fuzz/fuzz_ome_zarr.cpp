@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "resoct/formats/ome_zarr.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <exception>
 #include <string_view>
 
-#include "resoct/brick_source.hpp"
-#include "resoct/error.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::fuzz {
 

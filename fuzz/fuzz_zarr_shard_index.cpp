@@ -8,7 +8,7 @@
 #include <span>
 
 #include "fuzz_support.hpp"
-#include "resoct/formats/zarr_v3.hpp"
+#include "resoct/io/formats/zarr_v3.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace resoct;

@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "make_seeds.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/codec.hpp"
-#include "resoct/dense_volume.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/storage/codec.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::fuzz::seeds {
 

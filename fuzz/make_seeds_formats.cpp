@@ -15,8 +15,8 @@
 #include <zlib.h>
 
 #include "make_seeds.hpp"
-#include "resoct/codec.hpp"
-#include "resoct/image.hpp"
+#include "resoct/io/storage/codec.hpp"
+#include "resoct/render/image.hpp"
 
 namespace resoct::fuzz::seeds {
 

@@ -12,8 +12,8 @@
 #include <string_view>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/error.hpp"
-#include "resoct/frame_tables.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/frame_tables.hpp"
 #include "support/duplicate_source.hpp"
 #ifdef RESOCT_BENCH_HAVE_VULKAN
 #include "resoct/vulkan/vulkan_backend.hpp"

@@ -12,8 +12,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "resoct/backend.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/resident_scene.hpp"
 
 namespace resoct::bench {

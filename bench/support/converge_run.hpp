@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include "resoct/brick_source.hpp"
-#include "resoct/frame_stats.hpp"
-#include "resoct/image.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/render/frame_stats.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::bench {
 

@@ -12,9 +12,9 @@
 
 #include <glm/geometric.hpp>
 
-#include "resoct/brick_key.hpp"
-#include "resoct/camera.hpp"
-#include "resoct/error.hpp"
+#include "resoct/volume/brick_key.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::bench {
 

@@ -29,9 +29,9 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "resoct/brick_source.hpp"
-#include "resoct/image.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::bench {
 

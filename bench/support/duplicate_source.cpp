@@ -1,6 +1,6 @@
 #include "support/duplicate_source.hpp"
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::bench {
 

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "resoct/brick_source.hpp"
+#include "resoct/sources/brick_source.hpp"
 
 namespace resoct::bench {
 

@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "resoct/cpu/threads.hpp"
-#include "resoct/hierarchy.hpp"
+#include "resoct/volume/hierarchy.hpp"
 #ifdef CONSUMER_WITH_VULKAN
 #include "resoct/vulkan/devices.hpp"
 #endif

@@ -7,7 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::tools {
 

@@ -9,7 +9,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "resoct/voxel_type.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace CLI {
 class App;

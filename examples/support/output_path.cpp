@@ -2,7 +2,7 @@
 
 #include <sys/stat.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::tools {
 

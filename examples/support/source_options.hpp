@@ -2,7 +2,7 @@
 // The tools' options for remote sources (S3 endpoint, unsigned access), shared so that every tool
 // that opens a source spec spells them alike. HTTP behaviour keeps its defaults.
 
-#include "resoct/open_source.hpp"
+#include "resoct/io/open_source.hpp"
 
 namespace CLI {
 class App;

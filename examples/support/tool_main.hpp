@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::tools {
 

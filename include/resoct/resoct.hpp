@@ -5,12 +5,12 @@
 /// resoct/cpu/cpu_backend.hpp (resoct::cpu::make_backend) or resoct/vulkan/vulkan_backend.hpp
 /// (resoct::vk::make_backend).
 
-#include "resoct/camera.hpp"
-#include "resoct/error.hpp"
-#include "resoct/image.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/overview_scene.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/renderer_options.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/scene/overview_scene.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_options.hpp"
+#include "resoct/scene/scene.hpp"
 #include "resoct/version.hpp"

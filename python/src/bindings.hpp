@@ -4,7 +4,7 @@
 
 #include <pybind11/pybind11.h>
 
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::python {
 

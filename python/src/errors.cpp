@@ -1,7 +1,7 @@
 // resoct::Error becomes resoct.Error (a RuntimeError) carrying the library's message, which names
 // the parameter, file or JSON path at fault, and its code ("invalid_argument", "io", ...).
 #include "bindings.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::python {
 

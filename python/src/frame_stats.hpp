@@ -2,7 +2,7 @@
 // A frame's statistics as a Python dict (resoct.Frame.stats).
 
 #include "bindings.hpp"
-#include "resoct/frame_stats.hpp"
+#include "resoct/render/frame_stats.hpp"
 
 namespace resoct::python {
 

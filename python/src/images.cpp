@@ -4,7 +4,7 @@
 
 #include "bindings.hpp"
 #include "numpy_image.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::python {
 

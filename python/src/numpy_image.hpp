@@ -9,7 +9,7 @@
 #include <pybind11/numpy.h>
 
 #include "bindings.hpp"
-#include "resoct/image.hpp"
+#include "resoct/render/image.hpp"
 
 namespace resoct::python {
 

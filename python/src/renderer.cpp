@@ -11,8 +11,8 @@
 #include "frame_stats.hpp"
 #include "numpy_image.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/error.hpp"
-#include "resoct/renderer.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/renderer.hpp"
 #ifdef RESOCT_PYTHON_WITH_VULKAN
 #include "resoct/vulkan/vulkan_backend.hpp"
 #endif

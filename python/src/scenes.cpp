@@ -8,10 +8,10 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "resoct/brick_source.hpp"
-#include "resoct/camera.hpp"
-#include "resoct/error.hpp"
-#include "resoct/overview_scene.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/scene/overview_scene.hpp"
 
 namespace resoct::python {
 

@@ -12,9 +12,9 @@
 
 #include "bindings.hpp"
 #include "numpy_image.hpp"
-#include "resoct/error.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/io/open_source.hpp"
 
 namespace resoct::python {
 

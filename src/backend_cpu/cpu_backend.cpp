@@ -10,7 +10,7 @@
 
 #include <omp.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "kernel_access.hpp"
 
 namespace resoct::cpu::detail {

@@ -15,8 +15,8 @@
 
 #include <omp.h>
 
-#include "resoct/request_set.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/engine/request_set.hpp"
+#include "resoct/volume/voxel_type.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 

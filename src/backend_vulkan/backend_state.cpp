@@ -5,7 +5,7 @@
 #include <string>
 
 #include "backend_impl.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct_render_spv.h"
 
 namespace resoct::vk {

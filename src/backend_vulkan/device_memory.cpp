@@ -5,7 +5,7 @@
 #include <string>
 #include <utility>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::vk::detail {
 

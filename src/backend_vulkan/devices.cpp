@@ -2,7 +2,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::vk {
 

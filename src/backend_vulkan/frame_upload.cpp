@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "backend_impl.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::vk {
 

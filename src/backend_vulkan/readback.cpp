@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "backend_impl.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::vk {

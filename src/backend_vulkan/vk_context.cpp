@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/vulkan/devices.hpp"
 
 namespace resoct::vk::detail {

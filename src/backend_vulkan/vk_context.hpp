@@ -10,7 +10,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "resoct/backend.hpp"
+#include "resoct/backend/backend.hpp"
 
 namespace resoct::vk::detail {
 

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "backend_impl.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 

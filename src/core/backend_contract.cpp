@@ -1,8 +1,8 @@
 #include <string>
 
-#include "resoct/backend.hpp"
-#include "resoct/error.hpp"
-#include "resoct/transfer_function.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/scene/transfer_function.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 

@@ -1,8 +1,8 @@
 #include <map>
 #include <mutex>
 
-#include "resoct/backend.hpp"
-#include "resoct/error.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,9 +1,9 @@
-#include "resoct/brick_cache.hpp"
+#include "resoct/engine/brick_cache.hpp"
 
 #include <new>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 
 namespace resoct {

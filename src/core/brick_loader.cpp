@@ -1,11 +1,11 @@
-#include "resoct/brick_loader.hpp"
+#include "resoct/engine/brick_loader.hpp"
 
 #include <algorithm>
 #include <exception>
 #include <new>
 #include <utility>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,11 +1,11 @@
-#include "resoct/brick_source.hpp"
+#include "resoct/sources/brick_source.hpp"
 
 #include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -5,9 +5,9 @@
 #include <cstring>
 #include <string>
 
-#include "resoct/checksum.hpp"
-#include "resoct/error.hpp"
-#include "resoct/store/format.hpp"
+#include "resoct/io/storage/checksum.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/store/format.hpp"
 
 namespace resoct::detail {
 

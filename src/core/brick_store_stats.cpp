@@ -1,6 +1,6 @@
 #include <limits>
 
-#include "resoct/brick_store.hpp"
+#include "resoct/io/store/brick_store.hpp"
 
 namespace resoct {
 

@@ -9,12 +9,12 @@
 #include <string>
 #include <thread>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/checksum.hpp"
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/metadata_pyramid.hpp"
-#include "resoct/store/format.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/storage/checksum.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/io/store/format.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/byte_store.hpp"
+#include "resoct/io/storage/byte_store.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -6,8 +6,8 @@
 #include <system_error>
 
 #include "confined_path.hpp"
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/camera.hpp"
+#include "resoct/scene/camera.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 namespace {

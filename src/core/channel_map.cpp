@@ -1,9 +1,9 @@
-#include "resoct/channel_map.hpp"
+#include "resoct/engine/channel_map.hpp"
 
 #include <string>
 
-#include "resoct/error.hpp"
-#include "resoct/volume_desc.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 namespace resoct {
 

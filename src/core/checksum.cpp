@@ -1,4 +1,4 @@
-#include "resoct/checksum.hpp"
+#include "resoct/io/storage/checksum.hpp"
 
 #include <algorithm>
 

@@ -4,11 +4,11 @@
 #include <string>
 #include <string_view>
 
-#include "resoct/backend.hpp"
-#include "resoct/error.hpp"
-#include "resoct/eviction_policy.hpp"
-#include "resoct/renderer_options.hpp"
-#include "resoct/request_set.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/cache/eviction_policy.hpp"
+#include "resoct/render/renderer_options.hpp"
+#include "resoct/engine/request_set.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/codec.hpp"
+#include "resoct/io/storage/codec.hpp"
 
 #include <limits>
 #include <memory>
@@ -9,7 +9,7 @@
 #include <zstd.h>
 #include <zstd_errors.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

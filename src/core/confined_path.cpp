@@ -3,7 +3,7 @@
 #include <string>
 #include <system_error>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 

@@ -1,9 +1,9 @@
-#include "resoct/dense_volume.hpp"
+#include "resoct/volume/dense_volume.hpp"
 
 #include <algorithm>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

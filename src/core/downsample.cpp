@@ -1,4 +1,4 @@
-#include "resoct/downsample.hpp"
+#include "resoct/volume/downsample.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 #include <string>
 

@@ -1,11 +1,11 @@
-#include "resoct/eviction_policy.hpp"
+#include "resoct/cache/eviction_policy.hpp"
 
 #include <cmath>
 
 #include <glm/geometric.hpp>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -2,8 +2,8 @@
 #include <sstream>
 #include <string>
 
-#include "resoct/error.hpp"
-#include "resoct/formats/channel_stack.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/channel_stack.hpp"
 
 namespace resoct {
 

@@ -6,7 +6,7 @@
 
 #include <zlib.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 

@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "formats_level0_scan.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 

@@ -10,7 +10,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 
 namespace resoct::detail {
 

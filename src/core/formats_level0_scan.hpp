@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 
 namespace resoct::detail {
 

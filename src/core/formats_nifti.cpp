@@ -10,11 +10,11 @@
 #include "formats_inflate.hpp"
 #include "formats_placement.hpp"
 #include "formats_samples.hpp"
-#include "resoct/dense_volume.hpp"
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/formats/nifti.hpp"
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/formats/nifti.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 
 namespace resoct {
 

@@ -4,9 +4,9 @@
 #include <initializer_list>
 #include <string>
 
-#include "resoct/error.hpp"
-#include "resoct/formats/nifti.hpp"
-#include "resoct/volume_desc.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/nifti.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 namespace resoct {
 

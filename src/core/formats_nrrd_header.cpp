@@ -4,8 +4,8 @@
 #include <string>
 #include <utility>
 
-#include "resoct/error.hpp"
-#include "resoct/formats/nrrd.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/nrrd.hpp"
 
 namespace resoct {
 

@@ -3,9 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/byte_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/ome_multiscales.hpp"
+#include "resoct/io/storage/byte_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/ome_multiscales.hpp"
 
 namespace resoct {
 

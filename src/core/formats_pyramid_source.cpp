@@ -1,4 +1,4 @@
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -6,8 +6,8 @@
 
 #include "formats_lazy_metadata.hpp"
 #include "formats_level0_scan.hpp"
-#include "resoct/downsample.hpp"
-#include "resoct/error.hpp"
+#include "resoct/volume/downsample.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <span>
 
-#include "resoct/raw_volume.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/io/formats/raw_volume.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace resoct::detail {
 

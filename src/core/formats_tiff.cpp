@@ -14,10 +14,10 @@
 
 #include "confined_path.hpp"
 #include "formats_samples.hpp"
-#include "resoct/dense_volume.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/pyramid_source.hpp"
-#include "resoct/formats/tiff_stack.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/io/formats/tiff_stack.hpp"
 
 namespace resoct {
 

@@ -6,9 +6,9 @@
 #include "formats_inflate.hpp"
 #include "formats_samples.hpp"
 #include "formats_zarr_codec_steps.hpp"
-#include "resoct/codec.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/zarr_array.hpp"
+#include "resoct/io/storage/codec.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/zarr_array.hpp"
 
 namespace resoct {
 

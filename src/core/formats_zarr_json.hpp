@@ -8,8 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/error.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace resoct::detail {
 

@@ -4,9 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "formats_zarr_json.hpp"
-#include "resoct/formats/zarr_array.hpp"
+#include "resoct/io/formats/zarr_array.hpp"
 
 namespace resoct {
 

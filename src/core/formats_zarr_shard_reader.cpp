@@ -1,6 +1,6 @@
 #include "formats_zarr_shard_reader.hpp"
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 

@@ -11,8 +11,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "resoct/byte_store.hpp"
-#include "resoct/formats/zarr_v3.hpp"
+#include "resoct/io/storage/byte_store.hpp"
+#include "resoct/io/formats/zarr_v3.hpp"
 
 namespace resoct::detail {
 

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "formats_zarr_shard_reader.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/zarr_v3.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/zarr_v3.hpp"
 
 namespace resoct {
 

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "formats_zarr_json.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/zarr_v3.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/zarr_v3.hpp"
 
 namespace resoct {
 

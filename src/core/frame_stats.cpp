@@ -1,4 +1,4 @@
-#include "resoct/frame_stats.hpp"
+#include "resoct/render/frame_stats.hpp"
 
 #include <cstdio>
 

@@ -1,4 +1,4 @@
-#include "resoct/frame_tables.hpp"
+#include "resoct/render/frame_tables.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -9,12 +9,12 @@
 
 #include <glm/geometric.hpp>
 
-#include "resoct/camera.hpp"
-#include "resoct/error.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/preintegration.hpp"
-#include "resoct/residency_octree.hpp"
+#include "resoct/scene/preintegration.hpp"
+#include "resoct/engine/residency_octree.hpp"
 #include "frame_tables_slices.hpp"
 
 namespace resoct {

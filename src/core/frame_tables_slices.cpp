@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "resoct/camera.hpp"
-#include "resoct/error.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 namespace {

@@ -1,10 +1,10 @@
 #pragma once
 // Internal: the slice and lens part of build_frame_tables (kernel/slice.glsl.h, lens.glsl.h).
 
-#include "resoct/backend.hpp"
-#include "resoct/channel_map.hpp"
-#include "resoct/hierarchy.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/engine/channel_map.hpp"
+#include "resoct/volume/hierarchy.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::detail {
 

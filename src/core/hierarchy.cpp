@@ -1,10 +1,10 @@
-#include "resoct/hierarchy.hpp"
+#include "resoct/volume/hierarchy.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

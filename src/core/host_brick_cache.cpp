@@ -1,4 +1,4 @@
-#include "resoct/host_brick_cache.hpp"
+#include "resoct/cache/host_brick_cache.hpp"
 
 #include <algorithm>
 

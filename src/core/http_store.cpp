@@ -1,4 +1,4 @@
-#include "resoct/http_store.hpp"
+#include "resoct/io/http/http_store.hpp"
 
 #include <algorithm>
 #include <array>
@@ -15,7 +15,7 @@
 #include "http_origin.hpp"
 #include "percent_encoding.hpp"
 #include "s3_error_code.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

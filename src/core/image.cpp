@@ -1,4 +1,4 @@
-#include "resoct/image.hpp"
+#include "resoct/render/image.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 
 #include <png.h>
 
-#include "resoct/file_io.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/in_memory_source.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <limits>
 #include <string>
 
-#include "resoct/downsample.hpp"
-#include "resoct/error.hpp"
+#include "resoct/volume/downsample.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

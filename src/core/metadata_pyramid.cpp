@@ -1,10 +1,10 @@
-#include "resoct/metadata_pyramid.hpp"
+#include "resoct/volume/metadata_pyramid.hpp"
 
 #include <cmath>
 #include <cstring>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

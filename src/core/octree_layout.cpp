@@ -1,10 +1,10 @@
-#include "resoct/octree_layout.hpp"
+#include "resoct/engine/octree_layout.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/open_source.hpp"
+#include "resoct/io/open_source.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,19 +10,19 @@
 
 #include <sys/stat.h>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/formats/channel_stack.hpp"
-#include "resoct/formats/nifti.hpp"
-#include "resoct/formats/nrrd.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/tiff_stack.hpp"
-#include "resoct/http_store.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/random_access_file.hpp"
-#include "resoct/s3_store.hpp"
-#include "resoct/store/format.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/formats/channel_stack.hpp"
+#include "resoct/io/formats/nifti.hpp"
+#include "resoct/io/formats/nrrd.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/tiff_stack.hpp"
+#include "resoct/io/http/http_store.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/s3_store.hpp"
+#include "resoct/io/store/format.hpp"
 
 namespace resoct {
 

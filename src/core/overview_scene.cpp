@@ -1,4 +1,4 @@
-#include "resoct/overview_scene.hpp"
+#include "resoct/scene/overview_scene.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <glm/geometric.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

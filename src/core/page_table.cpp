@@ -1,4 +1,4 @@
-#include "resoct/page_table.hpp"
+#include "resoct/engine/page_table.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <new>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct {

@@ -1,4 +1,4 @@
-#include "resoct/prefetch.hpp"
+#include "resoct/engine/prefetch.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,11 +1,11 @@
-#include "resoct/preintegration.hpp"
+#include "resoct/scene/preintegration.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <glm/vec4.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

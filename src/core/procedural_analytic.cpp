@@ -4,8 +4,8 @@
 #include <cmath>
 #include <memory>
 
-#include "resoct/procedural/field.hpp"
-#include "resoct/procedural/math.hpp"
+#include "resoct/sources/procedural/field.hpp"
+#include "resoct/sources/procedural/math.hpp"
 
 namespace resoct::procedural {
 

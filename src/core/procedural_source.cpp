@@ -1,4 +1,4 @@
-#include "resoct/procedural_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "resoct/dense_volume.hpp"
-#include "resoct/downsample.hpp"
-#include "resoct/error.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/volume/downsample.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -5,8 +5,8 @@
 #include <memory>
 #include <vector>
 
-#include "resoct/procedural/field.hpp"
-#include "resoct/procedural/math.hpp"
+#include "resoct/sources/procedural/field.hpp"
+#include "resoct/sources/procedural/math.hpp"
 
 namespace resoct::procedural {
 

@@ -1,13 +1,13 @@
-#include "resoct/random_access_file.hpp"
+#include "resoct/base/random_access_file.hpp"
 
 #include <cctype>
 #include <limits>
 #include <optional>
 #include <utility>
 
-#include "resoct/error.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/http_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/http/http_store.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/raw_volume.hpp"
+#include "resoct/io/formats/raw_volume.hpp"
 
 #include <bit>
 #include <cerrno>
@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "formats_samples.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/renderer.hpp"
+#include "resoct/render/renderer.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "resoct/error.hpp"
-#include "resoct/frame_tables.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/frame_tables.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 

@@ -1,6 +1,6 @@
-#include "resoct/renderer_options.hpp"
+#include "resoct/render/renderer_options.hpp"
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/frame.glsl.h"
 
 namespace resoct {

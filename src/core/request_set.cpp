@@ -1,11 +1,11 @@
-#include "resoct/request_set.hpp"
+#include "resoct/engine/request_set.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <new>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct {

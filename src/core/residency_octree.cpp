@@ -1,15 +1,15 @@
 // Residency octree: construction, residency bit updates, remapping and word deltas. Metadata
 // lives in residency_octree_meta.cpp, the brute-force check in residency_octree_check.cpp.
-#include "resoct/residency_octree.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <new>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/volume_desc.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 namespace resoct {
 

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/residency_octree.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace resoct {
 

@@ -5,9 +5,9 @@
 #include <cstring>
 #include <string>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/residency_octree.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace resoct {
 

@@ -6,8 +6,8 @@
 #include <fstream>
 
 #include "http_origin.hpp"
-#include "resoct/error.hpp"
-#include "resoct/s3_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/http/s3_store.hpp"
 
 namespace resoct {
 

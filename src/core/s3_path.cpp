@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cctype>
 
-#include "resoct/error.hpp"
-#include "resoct/s3_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/http/s3_store.hpp"
 
 namespace resoct {
 

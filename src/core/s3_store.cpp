@@ -1,9 +1,9 @@
 // S3 objects through the HTTP machinery: an S3 store is an HttpStore whose base URL is the
 // bucket's address (s3_bucket_url) plus the spec's key prefix, with SigV4 signing on.
 #include "percent_encoding.hpp"
-#include "resoct/error.hpp"
-#include "resoct/random_access_file.hpp"
-#include "resoct/s3_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/s3_store.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/file_io.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/base/error.hpp"
 #include "scene_slices.hpp"
 
 namespace resoct {

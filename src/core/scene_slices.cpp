@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::detail {
 namespace {

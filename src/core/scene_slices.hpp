@@ -6,7 +6,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 
 namespace resoct::detail {
 

@@ -1,8 +1,8 @@
-#include "resoct/timepoint_sources.hpp"
+#include "resoct/sources/timepoint_sources.hpp"
 
 #include <algorithm>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

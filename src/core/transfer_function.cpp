@@ -1,11 +1,11 @@
-#include "resoct/transfer_function.hpp"
+#include "resoct/scene/transfer_function.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "resoct/error.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace resoct {
 namespace {

@@ -1,9 +1,9 @@
-#include "resoct/volume_desc.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 #include <cmath>
 #include <limits>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct {
 

@@ -1,4 +1,4 @@
-#include "resoct/voxel_type.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 #include <algorithm>
 #include <cmath>

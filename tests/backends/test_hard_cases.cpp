@@ -10,9 +10,9 @@
 
 #include "backend_test_util.hpp"
 #include "cpu/cpu_test_util.hpp"
-#include "resoct/camera.hpp"
-#include "resoct/dense_volume.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 
 namespace resoct::test {
 namespace {

@@ -13,9 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/error.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/time_series_source.hpp"
 #ifdef RESOCT_TEST_VULKAN
 #include "resoct/vulkan/devices.hpp"

@@ -2,7 +2,7 @@
 // device request keys can name (kernel/request_key.glsl.h).
 #include <gtest/gtest.h>
 
-#include "resoct/backend.hpp"
+#include "resoct/backend/backend.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 #include "support/expect_error.hpp"
 

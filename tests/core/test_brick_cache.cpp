@@ -5,7 +5,7 @@
 #include <map>
 #include <random>
 
-#include "resoct/brick_cache.hpp"
+#include "resoct/engine/brick_cache.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -8,8 +8,8 @@
 #include <random>
 #include <set>
 
-#include "resoct/brick_loader.hpp"
-#include "resoct/error.hpp"
+#include "resoct/engine/brick_loader.hpp"
+#include "resoct/base/error.hpp"
 #include "support/expect_error.hpp"
 #include "support/function_source.hpp"
 

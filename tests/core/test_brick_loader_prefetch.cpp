@@ -7,8 +7,8 @@
 #include <mutex>
 #include <set>
 
-#include "resoct/brick_loader.hpp"
-#include "resoct/error.hpp"
+#include "resoct/engine/brick_loader.hpp"
+#include "resoct/base/error.hpp"
 #include "support/function_source.hpp"
 
 namespace resoct {

@@ -7,9 +7,9 @@
 #include <memory>
 #include <vector>
 
-#include "resoct/brick_loader.hpp"
-#include "resoct/error.hpp"
-#include "resoct/timepoint_sources.hpp"
+#include "resoct/engine/brick_loader.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/timepoint_sources.hpp"
 #include "support/time_series_source.hpp"
 
 namespace resoct::test {

@@ -9,8 +9,8 @@
 #include <random>
 #include <set>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/codec.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/storage/codec.hpp"
 #include "support/expect_error.hpp"
 #include "support/function_source.hpp"
 #include "test_brick_store_util.hpp"

@@ -10,7 +10,7 @@
 #include <random>
 #include <thread>
 
-#include "resoct/brick_store.hpp"
+#include "resoct/io/store/brick_store.hpp"
 #include "support/expect_error.hpp"
 #include "support/function_source.hpp"
 #include "test_brick_store_util.hpp"

@@ -14,7 +14,7 @@
 
 #include <zlib.h>
 
-#include "resoct/volume_desc.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 namespace resoct::test {
 

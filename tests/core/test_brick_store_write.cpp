@@ -9,8 +9,8 @@
 
 #include <unistd.h>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/file_io.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/file_io.hpp"
 #include "support/expect_error.hpp"
 #include "support/function_source.hpp"
 #include "test_brick_store_util.hpp"

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <string>
 
-#include "resoct/byte_store.hpp"
-#include "resoct/error.hpp"
+#include "resoct/io/storage/byte_store.hpp"
+#include "resoct/base/error.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct {

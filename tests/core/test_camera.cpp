@@ -6,7 +6,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "resoct/camera.hpp"
+#include "resoct/scene/camera.hpp"
 #include "support/expect_error.hpp"
 
 namespace {

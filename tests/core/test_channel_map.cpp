@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "resoct/channel_map.hpp"
+#include "resoct/engine/channel_map.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 #include "support/expect_error.hpp"
 

@@ -6,8 +6,8 @@
 #include <random>
 #include <string>
 
-#include "resoct/checksum.hpp"
-#include "resoct/codec.hpp"
+#include "resoct/io/storage/checksum.hpp"
+#include "resoct/io/storage/codec.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include "resoct/downsample.hpp"
-#include "resoct/error.hpp"
+#include "resoct/volume/downsample.hpp"
+#include "resoct/base/error.hpp"
 #include "support/expect_error.hpp"
 #include "support/reference_levels.hpp"
 

@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/byte_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/nrrd.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/tiff_stack.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/storage/byte_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/nrrd.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/tiff_stack.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/level0_values.hpp"
 #include "support/tiff_writer.hpp"

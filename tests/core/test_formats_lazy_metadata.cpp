@@ -15,9 +15,9 @@
 #include <thread>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

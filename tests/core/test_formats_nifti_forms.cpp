@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/nifti.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/nifti.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/gzip_bytes.hpp"
 #include "support/level0_values.hpp"

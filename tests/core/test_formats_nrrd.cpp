@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/nrrd.hpp"
-#include "resoct/formats/pyramid_source.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/nrrd.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/gzip_bytes.hpp"
 #include "support/level0_values.hpp"

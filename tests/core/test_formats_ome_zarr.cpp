@@ -15,8 +15,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"
 #include "support/tool_process.hpp"

@@ -17,10 +17,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/zarr_v3.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/zarr_v3.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 #include "support/generated_data.hpp"

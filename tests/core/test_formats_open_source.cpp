@@ -8,8 +8,8 @@
 #include <string>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/error.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/formats/pyramid_source.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/pyramid_source.hpp"
-#include "resoct/formats/tiff_stack.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/io/formats/tiff_stack.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/level0_values.hpp"
 #include "support/tiff_writer.hpp"

@@ -12,10 +12,10 @@
 #include <zstd.h>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/error.hpp"
-#include "resoct/formats/ome_multiscales.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/formats/zarr_array.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/formats/ome_multiscales.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/formats/zarr_array.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

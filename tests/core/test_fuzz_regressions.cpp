@@ -7,10 +7,10 @@
 
 #include <string>
 
-#include "resoct/formats/nrrd.hpp"
-#include "resoct/formats/tiff_stack.hpp"
-#include "resoct/image.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/io/formats/nrrd.hpp"
+#include "resoct/io/formats/tiff_stack.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "resoct/error.hpp"
-#include "resoct/hierarchy.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/volume/hierarchy.hpp"
 
 using namespace resoct;
 

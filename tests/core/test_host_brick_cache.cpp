@@ -4,7 +4,7 @@
 #include <random>
 #include <thread>
 
-#include "resoct/host_brick_cache.hpp"
+#include "resoct/cache/host_brick_cache.hpp"
 
 namespace resoct {
 namespace {

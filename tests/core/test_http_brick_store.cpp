@@ -6,13 +6,13 @@
 
 #include <filesystem>
 
-#include "resoct/brick_loader.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/http_store.hpp"
-#include "resoct/random_access_file.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/engine/brick_loader.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/http/http_store.hpp"
+#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 #include "support/http_test_server.hpp"

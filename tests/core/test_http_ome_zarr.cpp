@@ -6,9 +6,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/http_store.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/http/http_store.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 #include "support/generated_data.hpp"

@@ -11,10 +11,10 @@
 #include <memory>
 #include <random>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/http_store.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/http/http_store.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/http_test_server.hpp"
 #include "test_brick_store_util.hpp"

@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/error.hpp"
-#include "resoct/http_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/http/http_store.hpp"
 #include "support/expect_error.hpp"
 #include "support/http_test_server.hpp"
 #include "test_brick_store_util.hpp"

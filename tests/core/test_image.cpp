@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/image.hpp"
+#include "resoct/render/image.hpp"
 #include "support/expect_error.hpp"
 
 namespace {

@@ -7,8 +7,8 @@
 #include <thread>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/reference_levels.hpp"
 

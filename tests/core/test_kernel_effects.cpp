@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/camera.hpp"
+#include "resoct/scene/camera.hpp"
 #include "resoct/kernel/frame.glsl.h"
 #include "support/function_source.hpp"
 #include "support/recording_backend.hpp"

@@ -4,10 +4,10 @@
 
 #include <random>
 
-#include "resoct/brick_cache.hpp"
+#include "resoct/engine/brick_cache.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/page_table.hpp"
+#include "resoct/engine/page_table.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

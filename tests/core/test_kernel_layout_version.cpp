@@ -8,9 +8,9 @@
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/page_table.hpp"
-#include "resoct/residency_octree.hpp"
-#include "resoct/transfer_function.hpp"
+#include "resoct/engine/page_table.hpp"
+#include "resoct/engine/residency_octree.hpp"
+#include "resoct/scene/transfer_function.hpp"
 #include "resoct/version.hpp"
 
 namespace resoct::test {

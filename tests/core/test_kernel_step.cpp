@@ -15,8 +15,8 @@ inline float resoct_read_level_size_log2(std::uint32_t level) {
 }
 }  // namespace resoct::kernel
 
-#include "resoct/camera.hpp"
-#include "resoct/hierarchy.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/volume/hierarchy.hpp"
 #include "resoct/kernel/step.glsl.h"
 
 namespace {

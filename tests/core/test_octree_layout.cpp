@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/octree_layout.hpp"
+#include "resoct/engine/octree_layout.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct {

@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/error.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/brick_compare.hpp"
 #include "test_brick_store_util.hpp"

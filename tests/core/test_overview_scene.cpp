@@ -6,8 +6,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "resoct/camera.hpp"
-#include "resoct/overview_scene.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/scene/overview_scene.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::test {

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/page_table.hpp"
+#include "resoct/engine/page_table.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

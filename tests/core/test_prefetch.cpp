@@ -3,8 +3,8 @@
 
 #include <set>
 
-#include "resoct/error.hpp"
-#include "resoct/prefetch.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/engine/prefetch.hpp"
 
 namespace resoct {
 namespace {

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/preintegration.hpp"
-#include "resoct/transfer_function.hpp"
+#include "resoct/scene/preintegration.hpp"
+#include "resoct/scene/transfer_function.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::kernel {

@@ -9,8 +9,8 @@
 #include <thread>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/reference_levels.hpp"
 

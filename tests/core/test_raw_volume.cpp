@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "resoct/error.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/raw_volume.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/io/formats/raw_volume.hpp"
 #include "support/expect_error.hpp"
 #include "test_brick_store_util.hpp"
 

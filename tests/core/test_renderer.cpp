@@ -1,7 +1,7 @@
 #include "test_renderer_support.hpp"
 
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/procedural_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::test {

@@ -3,8 +3,8 @@
 // and an unregistered backend name says how to get a backend.
 #include <gtest/gtest.h>
 
-#include "resoct/backend.hpp"
-#include "resoct/renderer_options.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/render/renderer_options.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::test {

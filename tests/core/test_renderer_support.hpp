@@ -9,9 +9,9 @@
 #include <mutex>
 #include <set>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
-#include "resoct/renderer.hpp"
+#include "resoct/render/renderer.hpp"
 #include "support/function_source.hpp"
 #include "support/recording_backend.hpp"
 

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/request_set.hpp"
+#include "resoct/engine/request_set.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "resoct/kernel/octree_node.glsl.h"
-#include "resoct/residency_octree.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace resoct {
 namespace {

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <map>
 
-#include "resoct/open_source.hpp"
-#include "resoct/s3_store.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/io/http/s3_store.hpp"
 #include "support/expect_error.hpp"
 #include "test_brick_store_util.hpp"
 

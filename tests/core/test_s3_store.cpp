@@ -8,13 +8,13 @@
 #include <filesystem>
 #include <fstream>
 
-#include "resoct/brick_store.hpp"
-#include "resoct/file_io.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/random_access_file.hpp"
-#include "resoct/s3_store.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/base/file_io.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/s3_store.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 #include "support/generated_data.hpp"

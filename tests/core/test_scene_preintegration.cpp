@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/frame_tables.hpp"
+#include "resoct/render/frame_tables.hpp"
 #include "resoct/kernel/effects.glsl.h"
-#include "resoct/preintegration.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/scene/preintegration.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/resident_scene.hpp"
 

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 
 namespace {

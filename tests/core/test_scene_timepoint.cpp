@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "resoct/scene.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

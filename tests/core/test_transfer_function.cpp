@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/transfer_function.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/scene/transfer_function.hpp"
+#include "resoct/volume/voxel_type.hpp"
 #include "support/expect_error.hpp"
 
 namespace resoct::kernel {

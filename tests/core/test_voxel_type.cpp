@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <limits>
 
-#include "resoct/error.hpp"
-#include "resoct/volume_desc.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/base/error.hpp"
+#include "resoct/volume/volume_desc.hpp"
+#include "resoct/volume/voxel_type.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -13,7 +13,7 @@
 #include "support/reference_renderer.hpp"
 #include "support/resident_scene.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 namespace resoct::test {
 

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/resident_scene.hpp"
 
 using namespace resoct;

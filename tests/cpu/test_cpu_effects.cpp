@@ -10,7 +10,7 @@
 
 #include "cpu_test_util.hpp"
 #include "support/function_source.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "support/test_views.hpp"
 
 namespace resoct::test {

@@ -10,8 +10,8 @@
 
 #include "cpu_test_util.hpp"
 #include "support/expect_error.hpp"
-#include "resoct/camera.hpp"
-#include "resoct/renderer.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/render/renderer.hpp"
 
 namespace resoct::test {
 namespace {

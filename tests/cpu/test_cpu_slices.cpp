@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "cpu_test_util.hpp"
-#include "resoct/camera.hpp"
+#include "resoct/scene/camera.hpp"
 #include "support/test_views.hpp"
 
 namespace resoct::test {

@@ -14,9 +14,9 @@
 
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/kernel/request_key.glsl.h"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/resident_scene.hpp"
 

@@ -7,7 +7,7 @@
 
 #include "cpu_test_util.hpp"
 #include "support/expect_error.hpp"
-#include "resoct/camera.hpp"
+#include "resoct/scene/camera.hpp"
 #include "support/test_views.hpp"
 
 namespace resoct::test {

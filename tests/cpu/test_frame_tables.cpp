@@ -7,8 +7,8 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
-#include "resoct/camera.hpp"
-#include "resoct/frame_tables.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/render/frame_tables.hpp"
 #include "resoct/kernel/camera_ray.glsl.h"
 
 namespace resoct {

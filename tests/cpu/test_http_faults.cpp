@@ -16,12 +16,12 @@
 #include <nlohmann/json.hpp>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/brick_store.hpp"
+#include "resoct/io/store/brick_store.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/http_test_server.hpp"
 #include "support/test_views.hpp"
 

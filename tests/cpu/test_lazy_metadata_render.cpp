@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/formats/pyramid_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 
 using namespace resoct;
 

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/open_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/io/open_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/generated_data.hpp"
 
 using namespace resoct;

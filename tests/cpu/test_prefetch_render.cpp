@@ -9,12 +9,12 @@
 #include <glm/geometric.hpp>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
-#include "resoct/prefetch.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/engine/prefetch.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;

@@ -8,9 +8,9 @@
 #include <set>
 
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/overview_scene.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
+#include "resoct/scene/overview_scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
 #include "support/expect_error.hpp"
 
 // Counts the allocations of the sizes of a frame's pixel buffers while `g_counting` is set: a

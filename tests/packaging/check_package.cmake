@@ -22,7 +22,7 @@ endfunction()
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${prefix})
-foreach(f include/resoct/hierarchy.hpp include/resoct/version.hpp
+foreach(f include/resoct/volume/hierarchy.hpp include/resoct/version.hpp
           include/resoct/kernel/layout_version.glsl.h lib/cmake/resoct/resoctConfig.cmake
           lib/cmake/resoct/resoctConfigVersion.cmake)
   if(NOT EXISTS ${prefix}/${f})

@@ -15,7 +15,7 @@
 
 #include "core/test_renderer_support.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/test_views.hpp"
 
 using namespace resoct;

@@ -1,7 +1,7 @@
 #pragma once
 // Bit-exact comparison of two brick sources over every brick of every channel and level.
 
-#include "resoct/brick_source.hpp"
+#include "resoct/sources/brick_source.hpp"
 
 namespace resoct::test {
 

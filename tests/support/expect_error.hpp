@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::test {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "resoct/voxel_type.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace resoct::test {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "resoct/brick_source.hpp"
+#include "resoct/sources/brick_source.hpp"
 
 namespace resoct::test {
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "loopback_server_process.hpp"
-#include "resoct/http_store.hpp"
+#include "resoct/io/http/http_store.hpp"
 
 namespace resoct::test {
 

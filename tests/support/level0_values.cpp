@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "resoct/formats/pyramid_source.hpp"
+#include "resoct/io/formats/pyramid_source.hpp"
 
 namespace resoct {
 

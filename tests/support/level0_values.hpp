@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "resoct/brick_source.hpp"
+#include "resoct/sources/brick_source.hpp"
 
 namespace resoct {
 

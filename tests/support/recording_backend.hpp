@@ -9,8 +9,8 @@
 #include <span>
 #include <vector>
 
-#include "resoct/backend.hpp"
-#include "resoct/page_table.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/engine/page_table.hpp"
 
 namespace resoct::test {
 

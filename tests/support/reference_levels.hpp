@@ -7,8 +7,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "resoct/hierarchy.hpp"
-#include "resoct/voxel_type.hpp"
+#include "resoct/volume/hierarchy.hpp"
+#include "resoct/volume/voxel_type.hpp"
 
 namespace resoct::test {
 

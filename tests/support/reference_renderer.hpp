@@ -24,10 +24,10 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "resoct/camera.hpp"
-#include "resoct/image.hpp"
-#include "resoct/scene.hpp"
-#include "resoct/volume_desc.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/scene/scene.hpp"
+#include "resoct/volume/volume_desc.hpp"
 
 namespace resoct::test {
 

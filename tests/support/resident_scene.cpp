@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::test {

@@ -10,13 +10,13 @@
 #include <memory>
 #include <vector>
 
-#include "resoct/backend.hpp"
-#include "resoct/brick_source.hpp"
-#include "resoct/channel_map.hpp"
-#include "resoct/frame_tables.hpp"
-#include "resoct/octree_layout.hpp"
-#include "resoct/page_table.hpp"
-#include "resoct/residency_octree.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/engine/channel_map.hpp"
+#include "resoct/render/frame_tables.hpp"
+#include "resoct/engine/octree_layout.hpp"
+#include "resoct/engine/page_table.hpp"
+#include "resoct/engine/residency_octree.hpp"
 
 namespace resoct::test {
 

@@ -4,8 +4,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "resoct/camera.hpp"
-#include "resoct/hierarchy.hpp"
+#include "resoct/scene/camera.hpp"
+#include "resoct/volume/hierarchy.hpp"
 
 namespace resoct::test {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "resoct/error.hpp"
+#include "resoct/base/error.hpp"
 
 namespace resoct::test {
 

@@ -6,8 +6,8 @@
 #include <cstring>
 #include <memory>
 
-#include "resoct/dense_volume.hpp"
-#include "resoct/formats/ome_zarr.hpp"
+#include "resoct/volume/dense_volume.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
 #include "support/brick_compare.hpp"
 #include "support/tool_process.hpp"
 

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "resoct/brick_source.hpp"
-#include "resoct/in_memory_source.hpp"
+#include "resoct/sources/brick_source.hpp"
+#include "resoct/sources/in_memory_source.hpp"
 
 namespace resoct::test {
 

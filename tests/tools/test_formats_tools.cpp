@@ -9,9 +9,9 @@
 #include <string>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/image.hpp"
-#include "resoct/open_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/render/image.hpp"
+#include "resoct/io/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"
 #include "support/tiff_writer.hpp"

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "core/test_brick_store_util.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/formats/ome_zarr.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"
 #include "support/s3_test_server.hpp"

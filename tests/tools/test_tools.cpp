@@ -21,10 +21,10 @@
 #include "core/test_brick_store_util.hpp"
 #include "support/brick_compare.hpp"
 #include "support/tool_process.hpp"
-#include "resoct/brick_store.hpp"
-#include "resoct/hierarchy.hpp"
-#include "resoct/in_memory_source.hpp"
-#include "resoct/procedural_source.hpp"
+#include "resoct/io/store/brick_store.hpp"
+#include "resoct/volume/hierarchy.hpp"
+#include "resoct/sources/in_memory_source.hpp"
+#include "resoct/sources/procedural_source.hpp"
 
 using namespace resoct;
 using resoct::test::expect_same_bricks;

@@ -17,9 +17,9 @@
 
 #include "vulkan_test_util.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
 namespace resoct::test {

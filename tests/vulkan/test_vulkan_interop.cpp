@@ -9,10 +9,10 @@
 
 #include "vulkan_test_util.hpp"
 #include "support/expect_error.hpp"
-#include "resoct/overview_scene.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/renderer.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/scene/overview_scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/render/renderer.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
 namespace resoct::test {

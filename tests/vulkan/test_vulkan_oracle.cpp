@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "vulkan_test_util.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
 namespace resoct::test {

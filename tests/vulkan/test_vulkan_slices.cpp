@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/procedural_source.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/scene/scene.hpp"
 #include "vulkan_test_util.hpp"
 #include "support/vulkan_required.hpp"
 

@@ -7,8 +7,8 @@
 
 #include "vulkan_test_util.hpp"
 #include "support/expect_error.hpp"
-#include "resoct/procedural_source.hpp"
-#include "resoct/scene.hpp"
+#include "resoct/sources/procedural_source.hpp"
+#include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
 namespace resoct::test {

@@ -9,8 +9,8 @@
 #include <memory>
 #include <vector>
 
-#include "resoct/backend.hpp"
-#include "resoct/request_set.hpp"
+#include "resoct/backend/backend.hpp"
+#include "resoct/engine/request_set.hpp"
 
 namespace resoct::cpu {
 

@@ -17,7 +17,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "resoct/backend.hpp"
+#include "resoct/backend/backend.hpp"
 
 namespace resoct::vk {
 
@@ -37,7 +37,7 @@ void register_backend();
 
 /// Device arrays a test can read back (debug_read()).
 /// `pages` is the page pool, `directory` and `directory_offsets` the sparse page table's
-/// directory (include/resoct/page_table.hpp).
+/// directory (include/resoct/engine/page_table.hpp).
 enum class DeviceArray : std::uint8_t { cache, pages, directory, directory_offsets, nodes };
 
 /// Not thread-safe: one Renderer drives it from one thread. update() copies its input into the

@@ -1,0 +1,117 @@
+#pragma once
+/// \file
+/// How a Renderer is set up, in three layers: the few choices a viewer makes (ViewerOptions), the
+/// expert tuning knobs of the frame loop (TuningOptions), and, for the command-line tools, the
+/// backend chosen by name (RendererOptions). docs/api.md has the guide.
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <thread>
+
+#include <glm/vec3.hpp>
+
+#include "resoct/backend/backend.hpp"
+#include "resoct/engine/brick_cache.hpp"
+#include "resoct/cache/eviction_policy.hpp"
+#include "resoct/engine/request_set.hpp"
+
+namespace resoct {
+
+/// Prefetching ahead of camera motion (paper 001; docs/renderer.md, "Prefetching"). Each frame
+/// the camera's next `lookahead_frames` poses are extrapolated linearly from its last two, and
+/// up to `max_bricks` / `max_bytes` (padded voxel bytes) bricks those views may need and that are
+/// neither on the device nor in the host cache are queued for loading into the host cache, below
+/// every real request.
+///
+/// Playing a time series (`next_timepoint`): each frame also queues, below the camera's
+/// prefetches, up to the same budget of bricks of the next timepoint (scene timepoint + 1,
+/// wrapping to 0) that the current view may need and the host cache lacks, so that switching to
+/// it is served from host memory (docs/renderer.md "Time series").
+struct PrefetchOptions {
+  std::uint32_t lookahead_frames = 0;                 ///< 0 disables prefetching; at most 64
+  std::uint32_t max_bricks = 64;                      ///< per frame, > 0 when enabled
+  std::uint64_t max_bytes = std::uint64_t(64) << 20;  ///< per frame, > 0 when enabled
+  bool next_timepoint = false;  ///< prefetch the next timepoint (no effect without a t axis)
+};
+
+/// Which pixels a FrameReport carries. Backends render float RGBA; the 8-bit form is what a
+/// texture upload or an image file wants, converted by the renderer into a reused buffer.
+enum class FrameOutput : std::uint8_t {
+  rgba32f,  ///< FrameReport::image only
+  rgba8,    ///< FrameReport::rgba8 only (FrameReport::image stays empty)
+  both,     ///< both
+};
+/// "rgba32f" / "rgba8" / "both".
+const char* to_string(FrameOutput o) noexcept;
+/// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
+FrameOutput parse_frame_output(std::string_view s, std::string_view parameter = "output");
+
+/// What a viewer chooses: memory, loading threads, the rendering method and the output form.
+struct ViewerOptions {
+  std::uint64_t device_cache_bytes = std::uint64_t(512) << 20;  ///< bricks on the device, > 0
+  std::uint64_t host_cache_bytes = std::uint64_t(1) << 30;      ///< decoded bricks in host memory
+  /// Loader threads; 0 loads synchronously inside render_frame (deterministic), at most 1024.
+  std::uint32_t loader_threads = std::max(1u, std::thread::hardware_concurrency());
+  RenderMode mode = RenderMode::residency;
+  RequestStrategy strategy = RequestStrategy::greedy;
+  Eviction eviction = Eviction::lru;  ///< device cache
+  /// Host cache; Eviction::octreemizer ranks by distance from the current camera.
+  Eviction host_eviction = Eviction::lru;
+  PrefetchOptions prefetch;
+  /// Bricks whose load failed with an error that may pass (a network or server fault, exhausted
+  /// host memory) are loaded again this long after the failure, then after twice as long each
+  /// time, up to 32 times (BrickLoader::set_transient_retry); each is still reported once, and a
+  /// frame is not converged while a retry is pending. 0 = a failed brick stays failed (its
+  /// coarser substitute is final). At most 3600000 (one hour).
+  std::uint32_t retry_failed_after_ms = 0;
+  FrameOutput output = FrameOutput::rgba32f;
+  /// Throws Error(invalid_argument) naming the field.
+  void validate() const;
+};
+
+/// The frame loop's expert knobs; the defaults suit every dataset the tests and benchmarks use.
+struct TuningOptions {
+  /// Visible channel slots of the page table and octree; 0 = the dataset's channel count,
+  /// capped at RESOCT_MAX_SLOTS (32).
+  std::uint32_t visible_slots = 0;
+  /// Blocks of 16^3 page-table entries the sparse page table may allocate (16 KiB of device
+  /// memory each; docs/core-structures.md). 0 = derived: the device cache's slots plus half as
+  /// many again (at least 64) of headroom, clamped to the blocks of all tables. Must exceed the
+  /// cache slots (so that a block without MAPPED entries can always be reclaimed) unless it
+  /// covers every block, and stay below 2^19.
+  std::uint32_t page_pool_blocks = 0;
+  UploadBudget upload_budget{256, std::numeric_limits<std::uint64_t>::max()};
+  std::uint32_t ttl = 2;     ///< frames a fresh upload stays pinned (>= 1)
+  glm::uvec3 leaf_size{16};  ///< residency octree leaf, voxels per axis
+  std::uint32_t brick_request_capacity = 1u << 16;
+  std::uint32_t node_request_capacity = 1u << 14;
+  /// Node metadata records (node x assigned slot) supplied per frame; bounds the host time per
+  /// frame (a procedural region_meta costs a few microseconds).
+  std::uint32_t max_node_answers = 16384;
+  std::uint32_t max_iterations = 1u << 20;  ///< march iterations per ray (cap)
+  std::uint32_t start_depth = 2;
+  /// Throws Error(invalid_argument) naming the field.
+  void validate() const;
+};
+
+/// Everything a Renderer takes. Its fields are those of both layers (`options.ttl`,
+/// `options.device_cache_bytes`), so a viewer passes ViewerOptions where RendererOptions is
+/// expected, and the tools set any field directly.
+struct RendererOptions : ViewerOptions, TuningOptions {
+  RendererOptions() = default;
+  /// A viewer's choices with default (or given) tuning. Implicit on purpose.
+  RendererOptions(const ViewerOptions& viewer, const TuningOptions& tuning = {})  // NOLINT
+      : ViewerOptions(viewer), TuningOptions(tuning) {}
+
+  /// Name-based backend creation (create_backend()), used by the Renderer constructor that takes
+  /// no backend object; the command-line tools choose backends this way.
+  std::string backend = "cpu";
+  BackendOptions backend_options;
+  /// Both layers' checks; throws Error(invalid_argument) naming the field.
+  void validate() const;
+};
+
+}  // namespace resoct
