@@ -6,7 +6,7 @@ on the same sphere volume, camera and transfer function.
                                                                 when DISPLAY is not set)
 
 Both render procedural:sphere at --size³ (float32, v = max(0, 1 - r / R) at voxel centres, the
-formula of src/core/procedural_analytic.cpp SphereField evaluated in double and rounded to float
+formula of src/core/sources/procedural/analytic.cpp SphereField evaluated in double and rounded to float
 once, as ProceduralSource stores f32 voxels) with the camera, viewport and transfer function of
 examples/scenes/sphere.json, on --threads threads. VTK: trilinear interpolation, no shading,
 sample distance and scalar-opacity unit distance one voxel (resoct's TF alpha is the opacity of
