@@ -1,5 +1,5 @@
-# Install rules and the exported package: find_package(resoct 0.1 COMPONENTS cpu vulkan) works
-# from the install tree and from the build tree.
+# Install rules and the exported package: find_package(resoct 0.1 COMPONENTS io cpu vulkan)
+# works from the install tree and from the build tree.
 set(RESOCT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/resoct)
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/resoct DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
@@ -11,7 +11,7 @@ if(RESOCT_WITH_VULKAN)
           DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/resoct)
 endif()
 
-foreach(component core cpu vulkan)
+foreach(component core io cpu vulkan)
   if(TARGET resoct_${component})
     install(TARGETS resoct_${component} EXPORT resoct-${component}-targets
             LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

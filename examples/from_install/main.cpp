@@ -4,6 +4,10 @@
 
 #include "resoct/cpu/threads.hpp"
 #include "resoct/volume/hierarchy.hpp"
+#ifdef CONSUMER_WITH_IO
+#include "resoct/io/open_source.hpp"
+#include "resoct/sources/brick_source.hpp"
+#endif
 #ifdef CONSUMER_WITH_VULKAN
 #include "resoct/vulkan/devices.hpp"
 #endif
@@ -22,6 +26,12 @@ int main() {
                 static_cast<unsigned long long>(li.brick_count));
   }
   std::printf("cpu threads: %d\n", resoct::cpu::thread_count());
+#ifdef CONSUMER_WITH_IO
+  // resoct::io: a source opened by its spec string.
+  const auto source = resoct::open_source("procedural:cells:64x64x16");
+  std::printf("io: procedural:cells:64x64x16 has %u levels\n", source->hierarchy().level_count());
+  if (source->hierarchy().level_count() == 0) return 1;
+#endif
 #ifdef CONSUMER_WITH_VULKAN
   std::printf("vulkan devices: %zu\n", resoct::vk::list_devices().size());
 #endif

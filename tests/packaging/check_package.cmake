@@ -3,7 +3,7 @@
 # Both consumers also build the viewer API examples (examples/NN_*.cpp) and run 02, the README's
 # C++ snippet. With -DPYTHON, the README's Python snippet (examples/python/render_frame.py) runs
 # with the module installed into <prefix>/PYTHON_DIR.
-# Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "cpu;vulkan"),
+# Inputs: -DSOURCE_DIR -DBINARY_DIR -DWORK_DIR -DCOMPONENTS (semicolon list, e.g. "io;cpu;vulkan"),
 # optionally -DPYTHON (interpreter) -DPYTHON_DIR (module directory below the prefix), and
 # -DCONSUMER_CXX_COMPILER and -DCONSUMER_CXX_FLAGS, resoct's own, for the consumer.
 foreach(v SOURCE_DIR BINARY_DIR WORK_DIR COMPONENTS)
@@ -23,8 +23,9 @@ file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 run(${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${prefix})
 foreach(f include/resoct/volume/hierarchy.hpp include/resoct/version.hpp
-          include/resoct/kernel/layout_version.glsl.h lib/cmake/resoct/resoctConfig.cmake
-          lib/cmake/resoct/resoctConfigVersion.cmake)
+          include/resoct/io/open_source.hpp include/resoct/kernel/layout_version.glsl.h
+          lib/cmake/resoct/resoctConfig.cmake lib/cmake/resoct/resoctConfigVersion.cmake
+          lib/cmake/resoct/resoct-core-targets.cmake lib/cmake/resoct/resoct-io-targets.cmake)
   if(NOT EXISTS ${prefix}/${f})
     message(FATAL_ERROR "install tree lacks ${f}")
   endif()
@@ -62,7 +63,7 @@ endforeach()
 # A component that was not built must make find_package fail, not silently succeed.
 set(bdir ${WORK_DIR}/consumer-missing)
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/from_install -B ${bdir} -G Ninja
-                -DCMAKE_PREFIX_PATH=${prefix} -DRESOCT_CONSUMER_COMPONENTS=cpu\;nonexistent
+                -DCMAKE_PREFIX_PATH=${prefix} -DRESOCT_CONSUMER_COMPONENTS=io\;cpu\;nonexistent
                 RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
 if(rc EQUAL 0)
   message(FATAL_ERROR "find_package succeeded with a nonexistent component")
