@@ -1,4 +1,4 @@
-// The tools' documented exit codes (docs/tools.md, docs/renderer.md, examples/support/
+// The tools' documented exit codes (docs/tools.md, docs/renderer.md, examples/tools/support/
 // tool_main.hpp): 0 success, 1 bad input (a resoct::Error), 2 usage error, 3 anything else; each
 // failure is one line on stderr, and an output that existed before a failed run is left
 // byte-identical (no temporary file left beside it either).
