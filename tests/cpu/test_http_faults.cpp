@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/store/brick_store.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/io/open_source.hpp"

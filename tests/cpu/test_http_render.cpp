@@ -2,7 +2,7 @@
 // rendering the same store from the local file, frame by frame, with the same convergence.
 #include <gtest/gtest.h>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/store/brick_store.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/io/open_source.hpp"

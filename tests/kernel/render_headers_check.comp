@@ -1,7 +1,7 @@
 #version 450
 // Compile check: the render kernel headers are valid GLSL 4.50
-// (tests/core/test_render_kernel_glsl.cpp runs glslangValidator on this file). Every function is
-// called so that it is type-checked.
+// (tests/core/kernel/test_render_kernel_glsl.cpp runs glslangValidator on this file). Every
+// function is called so that it is type-checked.
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 1) in;
 

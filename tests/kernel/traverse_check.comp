@@ -1,5 +1,5 @@
 #version 450
-// Compile check: the traversal kernel is valid GLSL 4.50 (tests/core/test_traverse_glsl.cpp
+// Compile check: the traversal kernel is valid GLSL 4.50 (tests/core/kernel/test_traverse_glsl.cpp
 // runs glslangValidator on this file). Defines every accessor over storage buffers, includes
 // the kernel and renders one pixel per invocation.
 #extension GL_GOOGLE_include_directive : require

@@ -13,7 +13,7 @@
 #include <fstream>
 #include <random>
 
-#include "core/test_renderer_support.hpp"
+#include "core/render/test_renderer_support.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "support/test_views.hpp"

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/store/brick_store.hpp"
 #include "resoct/render/image.hpp"
 #include "resoct/io/open_source.hpp"

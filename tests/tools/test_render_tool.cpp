@@ -18,7 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "support/tool_process.hpp"
 #include "support/vulkan_required.hpp"
 #include "resoct/render/image.hpp"

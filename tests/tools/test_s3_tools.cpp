@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/store/brick_store.hpp"
 #include "resoct/io/formats/ome_zarr.hpp"
 #include "resoct/sources/procedural_source.hpp"

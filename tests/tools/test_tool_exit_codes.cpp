@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "support/generated_data.hpp"
 #include "support/sanitized.hpp"
 #include "support/tool_process.hpp"

@@ -10,7 +10,7 @@
 #include "resoct/sources/procedural_source.hpp"
 #include "support/expect_error.hpp"
 #include "support/brick_compare.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::expect_same_bricks;

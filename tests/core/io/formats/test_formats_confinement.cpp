@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/storage/byte_store.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/io/formats/nrrd.hpp"

@@ -17,7 +17,7 @@
 #include "resoct/io/http/http_store.hpp"
 #include "support/expect_error.hpp"
 #include "support/http_test_server.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::fast_http_options;

@@ -16,7 +16,7 @@
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
 #include "support/http_test_server.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::HttpTestServer;

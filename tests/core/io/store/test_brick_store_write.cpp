@@ -13,7 +13,7 @@
 #include "resoct/base/file_io.hpp"
 #include "support/expect_error.hpp"
 #include "support/function_source.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::FunctionSource;

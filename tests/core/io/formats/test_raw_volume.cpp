@@ -13,7 +13,7 @@
 #include "resoct/sources/in_memory_source.hpp"
 #include "resoct/io/formats/raw_volume.hpp"
 #include "support/expect_error.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::TempDir;

@@ -10,7 +10,7 @@
 #include "resoct/io/open_source.hpp"
 #include "resoct/io/http/s3_store.hpp"
 #include "support/expect_error.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 

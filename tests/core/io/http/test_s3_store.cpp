@@ -20,7 +20,7 @@
 #include "support/generated_data.hpp"
 #include "support/http_test_server.hpp"
 #include "support/s3_test_server.hpp"
-#include "test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 
 using namespace resoct;
 using resoct::test::S3TestServer;

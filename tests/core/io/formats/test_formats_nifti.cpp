@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/io/formats/nifti.hpp"
 #include "resoct/io/formats/pyramid_source.hpp"

@@ -4,7 +4,7 @@
 // rest prefetches nothing.
 #include <gtest/gtest.h>
 
-#include "test_renderer_support.hpp"
+#include "core/render/test_renderer_support.hpp"
 
 namespace resoct {
 namespace {

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/io/open_source.hpp"
 #include "support/expect_error.hpp"

@@ -11,7 +11,7 @@
 #include <lz4.h>
 #include <zstd.h>
 
-#include "core/test_brick_store_util.hpp"
+#include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/io/formats/ome_multiscales.hpp"
 #include "resoct/io/formats/ome_zarr.hpp"

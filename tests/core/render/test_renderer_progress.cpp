@@ -1,6 +1,6 @@
 // The renderer under pressure: a device cache smaller than the working set, channel remaps while
 // loads are in flight, and bricks that fail to load.
-#include "test_renderer_support.hpp"
+#include "core/render/test_renderer_support.hpp"
 
 #include <random>
 

@@ -1,4 +1,4 @@
-#include "test_renderer_support.hpp"
+#include "core/render/test_renderer_support.hpp"
 
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/sources/procedural_source.hpp"
