@@ -56,7 +56,7 @@
 
 #include "resoct/base/error.hpp"
 #include "resoct/render/frame_tables.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/bench_rig.hpp"
 #include "support/dense_march.hpp"

@@ -11,7 +11,7 @@
 #include <zlib.h>
 
 #include "fuzz_support.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 
 namespace {
 

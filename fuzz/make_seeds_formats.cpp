@@ -16,7 +16,7 @@
 
 #include "make_seeds.hpp"
 #include "resoct/io/storage/codec.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 
 namespace resoct::fuzz::seeds {
 

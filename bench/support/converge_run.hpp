@@ -8,7 +8,7 @@
 
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/render/frame_stats.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/render/renderer.hpp"
 #include "resoct/scene/scene.hpp"
 

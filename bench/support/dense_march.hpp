@@ -30,7 +30,7 @@
 #include <glm/vec4.hpp>
 
 #include "resoct/sources/brick_source.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/scene/scene.hpp"
 
 namespace resoct::bench {

@@ -7,7 +7,7 @@
 
 #include "resoct/scene/camera.hpp"
 #include "resoct/base/error.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/scene/overview_scene.hpp"
 #include "resoct/render/renderer.hpp"

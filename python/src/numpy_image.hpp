@@ -9,7 +9,7 @@
 #include <pybind11/numpy.h>
 
 #include "bindings.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 
 namespace resoct::python {
 

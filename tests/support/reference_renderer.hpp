@@ -25,7 +25,7 @@
 #include <glm/vec4.hpp>
 
 #include "resoct/scene/camera.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/scene/scene.hpp"
 #include "resoct/volume/volume_desc.hpp"
 

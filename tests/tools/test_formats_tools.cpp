@@ -10,7 +10,7 @@
 
 #include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/io/store/brick_store.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/io/open_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"

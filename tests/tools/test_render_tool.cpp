@@ -21,7 +21,7 @@
 #include "core/io/store/test_brick_store_util.hpp"
 #include "support/tool_process.hpp"
 #include "support/vulkan_required.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 
 using resoct::test::slurp;
 using resoct::test::TempDir;

@@ -18,7 +18,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/engine/page_table.hpp"
 #include "resoct/engine/request_set.hpp"

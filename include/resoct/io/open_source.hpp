@@ -57,7 +57,7 @@ struct SourceOptions {
 /// - an OME-Zarr directory, a NIfTI, NRRD or TIFF file, or a directory of TIFF files gives the
 ///   format's source (include/resoct/io/formats/, docs/formats.md), bricked with `layout`;
 /// - `stack:A+B+...` opens every part with open_source and stacks their channels
-///   (formats/channel_stack.hpp);
+///   (io/formats/channel_stack.hpp);
 /// - an http:// or https:// URL (default HttpOptions, docs/http.md): an OME-Zarr image when the
 ///   URL has a `.zattrs` or `.zarray` below it, read through an HttpStore (a URL map
 ///   "URL,PREFIX=URL,..." routes key prefixes to other hosts and always means OME-Zarr), else a

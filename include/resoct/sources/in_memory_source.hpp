@@ -10,7 +10,7 @@
 
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/volume/dense_volume.hpp"
-#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/sources/metadata_pyramid.hpp"
 
 namespace resoct {
 

@@ -43,7 +43,7 @@ struct OmeZarrOptions {
 };
 
 namespace detail {
-struct ZarrImage;  // metadata, arrays and the decoded-chunk cache (formats_zarr_source.cpp)
+struct ZarrImage;  // metadata, arrays and the decoded-chunk cache (zarr_source.cpp)
 }
 
 /// An opened OME-Zarr image (create it with open_ome_zarr). Thread-safety: as BrickSource.

@@ -21,12 +21,12 @@
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/volume/dense_volume.hpp"
 #include "resoct/cache/host_brick_cache.hpp"
-#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/sources/metadata_pyramid.hpp"
 
 namespace resoct {
 
 namespace detail {
-class LazyMetadata;  // on-demand block summaries (formats_lazy_metadata.hpp)
+class LazyMetadata;  // on-demand block summaries (src/core/io/formats/lazy_metadata.hpp)
 }
 
 /// Fills `out` (dense, x fastest) with the voxels of `box` of one channel of one level; the box

@@ -14,7 +14,7 @@
 #include "resoct/io/storage/codec.hpp"
 #include "resoct/base/file_io.hpp"
 #include "resoct/volume/hierarchy.hpp"
-#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/sources/metadata_pyramid.hpp"
 
 namespace resoct::detail {
 

@@ -83,7 +83,7 @@ std::unique_ptr<BrickSource> open_nrrd(const std::string& path, const BrickLayou
   start = skip_lines(data, start, h.line_skip);
 
   // With space directions the voxels are served in world order (NIfTI's rule, one for every
-  // format: formats_placement.hpp); without them in index order at origin 0.
+  // format: io/formats/placement.hpp); without them in index order at origin 0.
   detail::Placement place;
   place.spacing = h.spacing;
   if (h.world_axes) place = detail::place_grid({*h.world_axes, h.world_origin}, h.extent());

@@ -13,7 +13,7 @@
 #include "resoct/io/storage/checksum.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/base/file_io.hpp"
-#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/sources/metadata_pyramid.hpp"
 #include "resoct/io/store/format.hpp"
 
 namespace resoct {

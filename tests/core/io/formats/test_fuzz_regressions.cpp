@@ -9,7 +9,7 @@
 
 #include "resoct/io/formats/nrrd.hpp"
 #include "resoct/io/formats/tiff_stack.hpp"
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 

@@ -1,4 +1,4 @@
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "resoct/render/image.hpp"
+#include "resoct/backend/image.hpp"
 #include "support/expect_error.hpp"
 
 namespace {

@@ -1,4 +1,4 @@
-#include "resoct/volume/metadata_pyramid.hpp"
+#include "resoct/sources/metadata_pyramid.hpp"
 
 #include <cmath>
 #include <cstring>
