@@ -28,7 +28,8 @@ constexpr Choice<RequestStrategy> kStrategies[] = {{"greedy", RequestStrategy::g
 constexpr Choice<Eviction> kEvictions[] = {{"lru", Eviction::lru},
                                            {"octreemizer", Eviction::octreemizer}};
 constexpr Choice<FrameOutput> kOutputs[] = {
-    {"rgba32f", FrameOutput::rgba32f}, {"rgba8", FrameOutput::rgba8}, {"both", FrameOutput::both}};
+    {"rgba32f", FrameOutput::rgba32f}, {"rgba8", FrameOutput::rgba8}, {"both", FrameOutput::both},
+    {"device", FrameOutput::device}};
 
 // "unknown" for a value outside the table (an enum made by a cast from a bad integer), which
 // ViewerOptions::validate() reports.
