@@ -158,8 +158,8 @@ void copy_device_image(const AppDevice& d, const DeviceImage& image, std::vector
   from_kernel.buffer = vk::buffer_of(image);
   from_kernel.offset = image.offset;
   from_kernel.size = image.bytes;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       0, 0, nullptr, 1, &from_kernel, 0, nullptr);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                       0, nullptr, 1, &from_kernel, 0, nullptr);
   const VkBufferCopy region{image.offset, 0, image.bytes};
   vkCmdCopyBuffer(cmd, vk::buffer_of(image), host, 1, &region);
   VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
@@ -289,9 +289,9 @@ TEST_F(VulkanInterop, DeviceOutputStaysOnTheDeviceAndEqualsTheReadBack) {
   copy_device_image(app_, f.device_image, pixels);
   if (HasFatalFailure()) return;
   ASSERT_EQ(pixels.size(), a.last.image.pixels().size());
-  EXPECT_EQ(std::memcmp(pixels.data(), a.last.image.pixels().data(),
-                        pixels.size() * sizeof(glm::vec4)),
-            0);
+  EXPECT_EQ(
+      std::memcmp(pixels.data(), a.last.image.pixels().data(), pixels.size() * sizeof(glm::vec4)),
+      0);
   EXPECT_GT(a.last.image.at(20, 16).a, 0.0f);
 }
 
