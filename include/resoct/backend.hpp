@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -23,6 +24,7 @@
 #include "resoct/page_table.hpp"
 #include "resoct/request_set.hpp"
 #include "resoct/residency_octree.hpp"
+#include "resoct/transfer_function.hpp"
 #include "resoct/voxel_type.hpp"
 
 namespace resoct {
@@ -89,6 +91,14 @@ struct FrameTables {
   /// With RESOCT_EFFECT_PREINT in fx.effects: page_slot_count * 2 * RESOCT_TF_LUT_SIZE entries,
   /// indexed by slot (preintegration_table(), kernel/preintegration.glsl.h); else empty.
   std::vector<glm::vec4> preint_tables;
+  /// What build_frame_tables() built tf_luts and preint_tables from, so that a build into the
+  /// same tables recomputes only what changed (a camera move recomputes no LUT). Per page slot:
+  /// the transfer function whose LUT tf_luts holds (none: the LUT is zero), and whether
+  /// preint_tables holds that LUT's pre-integration table. Backends do not read these.
+  std::vector<std::optional<TransferFunction>> lut_sources;
+  std::vector<std::uint8_t> preint_built;
+  /// Transfer-function LUTs the last build computed; the other slots' LUTs were kept.
+  std::uint32_t luts_built = 0;
   /// Whether render() must copy the image into host memory (FrameResult::image). When false, a
   /// backend that renders into device memory leaves the pixels there, describes them in
   /// FrameResult::device_image and leaves FrameResult::image as it was; a backend that renders

@@ -487,7 +487,8 @@ const FrameTables& Renderer::frame_tables(const Scene& scene) {
   fo.request_strategy = options_.strategy;
   fo.start_depth = options_.start_depth;
   fo.max_iterations = options_.max_iterations;
-  // Rebuilt every frame (camera and TFs change) into the same vectors: no per-frame allocation.
+  // Rebuilt every frame into the same tables: no per-frame allocation, and only the LUTs of
+  // transfer functions that changed are computed again (FrameTables::lut_sources).
   build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
   tables_.image_to_host = options_.output != FrameOutput::device;
   return tables_;
