@@ -60,6 +60,12 @@ std::unique_ptr<Renderer> make_renderer(
   o.eviction = parse_eviction(eviction);
   o.host_eviction = parse_eviction(host_eviction, "host_eviction");
   o.output = parse_frame_output(output);
+  if (o.output == FrameOutput::device) {
+    // Python reads frames as numpy arrays: an image left in GPU memory would arrive empty.
+    throw invalid_parameter("output",
+                            "\"device\" leaves the image in GPU memory, which Python "
+                            "cannot read; use \"rgba32f\", \"rgba8\" or \"both\"");
+  }
   o.prefetch.lookahead_frames = prefetch_frames;
   o.validate();  // before a device is created for options that would be refused anyway
   std::unique_ptr<Backend> b = make_named_backend(backend, threads, device, validation);

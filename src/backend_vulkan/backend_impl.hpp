@@ -158,16 +158,18 @@ struct VulkanBackend::Impl {
   /// Sizes the per-frame buffers and copies the frame tables into them.
   void upload_tables(const FrameTables& tables);
   /// Records clearing the per-frame outputs, the dispatch and the barriers around it.
-  void record_render(const kernel::ResoctFrame& frame, VkPipeline pipeline);
+  void record_render(const FrameTables& tables, VkPipeline pipeline);
   /// Where a frame of `pixels` pixels puts its outputs in the readback buffer.
   detail::ReadbackLayout readback_layout(std::size_t pixels) const;
   /// Ends an unsubmitted batch without running it (configure() replaces all state anyway).
   void discard_batch() noexcept;
-  /// Records copying the frame's outputs (image, statistics, request sets, used bits) into the
-  /// readback buffer, followed by a barrier to host reads.
-  void record_readback(const kernel::ResoctFrame& frame);
-  /// Image, statistics, requests and used slots of the finished frame from the readback buffer.
-  void read_results(const kernel::ResoctFrame& frame, FrameResult& result) const;
+  /// Records copying the frame's outputs (image unless it stays on the device, statistics,
+  /// request sets, used bits) into the readback buffer, followed by a barrier to host reads.
+  void record_readback(const kernel::ResoctFrame& frame, bool image_to_host);
+  /// Image (or its place on the device), statistics, requests and used slots of the finished
+  /// frame from the readback buffer.
+  void read_results(const kernel::ResoctFrame& frame, bool image_to_host,
+                    FrameResult& result) const;
 };
 
 }  // namespace resoct::vk

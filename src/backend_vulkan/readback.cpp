@@ -32,6 +32,20 @@ void drain(const std::uint32_t* set, std::uint32_t cap, std::vector<Request>& ou
 
 }  // namespace
 
+std::uint64_t handle_of(VkBuffer buffer) noexcept {
+  // A pointer on 64-bit platforms, a uint64_t on 32-bit ones: copied bit for bit either way.
+  static_assert(sizeof(VkBuffer) <= sizeof(std::uint64_t));
+  std::uint64_t h = 0;
+  std::memcpy(&h, &buffer, sizeof(buffer));
+  return h;
+}
+
+VkBuffer buffer_of(const DeviceImage& image) noexcept {
+  VkBuffer b = VK_NULL_HANDLE;
+  std::memcpy(&b, &image.handle, sizeof(b));
+  return b;
+}
+
 ReadbackLayout detail::readback_layout(std::size_t pixels, std::uint32_t brick_capacity,
                                        std::uint32_t node_capacity, std::uint32_t cache_slots) {
   ReadbackLayout l;
@@ -48,7 +62,7 @@ ReadbackLayout VulkanBackend::Impl::readback_layout(std::size_t pixels) const {
   return detail::readback_layout(pixels, brick_capacity, node_capacity, config.cache_slots);
 }
 
-void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame) {
+void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame, bool image_to_host) {
   const ReadbackLayout l = readback_layout(std::size_t(frame.width) * frame.height);
   barrier();
   auto copy = [&](Binding b, VkDeviceSize to, VkDeviceSize bytes) {
@@ -56,7 +70,8 @@ void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame) {
     const VkBufferCopy region{0, to, bytes};
     vkCmdCopyBuffer(cmd, buf[b].buffer, readback.buffer, 1, &region);
   };
-  copy(b_out, l.image, l.brick_requests - l.image);
+  // An image that stays on the device (FrameTables::image_to_host false) is not copied.
+  if (image_to_host) copy(b_out, l.image, l.brick_requests - l.image);
   copy(b_brick_requests, l.brick_requests, l.node_requests - l.brick_requests);
   copy(b_node_requests, l.node_requests, l.used - l.node_requests);
   copy(b_used, l.used, l.stats - l.used);
@@ -68,15 +83,26 @@ void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame) {
                        &to_host, 0, nullptr, 0, nullptr);
 }
 
-void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame,
+void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame, bool image_to_host,
                                        FrameResult& result) const {
   const std::size_t pixels = std::size_t(frame.width) * frame.height;
   const ReadbackLayout l = readback_layout(pixels);
   const auto* base = static_cast<const std::byte*>(readback.mapped);
-  if (result.image.width() != frame.width || result.image.height() != frame.height) {
-    result.image = Image(frame.width, frame.height);
+  if (image_to_host) {
+    if (result.image.width() != frame.width || result.image.height() != frame.height) {
+      result.image = Image(frame.width, frame.height);
+    }
+    std::memcpy(result.image.pixels().data(), base + l.image, pixels * sizeof(glm::vec4));
+    result.device_image = DeviceImage{};
+  } else {
+    // The kernel wrote the image to b_out from offset 0, rows top to bottom (render.comp).
+    DeviceImage& d = result.device_image;
+    d.handle = handle_of(buf[b_out].buffer);
+    d.offset = 0;
+    d.bytes = std::uint64_t(pixels) * sizeof(glm::vec4);
+    d.width = frame.width;
+    d.height = frame.height;
   }
-  std::memcpy(result.image.pixels().data(), base + l.image, pixels * sizeof(glm::vec4));
 
   const auto* st = reinterpret_cast<const std::uint32_t*>(base + l.stats);
   auto stat = [st](std::uint32_t i) {

@@ -200,7 +200,8 @@ RenderVariant VulkanBackend::Impl::render_variant(const FrameTables& tables) con
   return v;
 }
 
-void VulkanBackend::Impl::record_render(const kernel::ResoctFrame& frame, VkPipeline pipeline) {
+void VulkanBackend::Impl::record_render(const FrameTables& tables, VkPipeline pipeline) {
+  const kernel::ResoctFrame& frame = tables.frame;
   begin_batch();
   // Table copies and delta scatters of this batch are done before the clears and the dispatch.
   barrier();
@@ -228,7 +229,7 @@ void VulkanBackend::Impl::record_render(const kernel::ResoctFrame& frame, VkPipe
   vkCmdDispatch(cmd, (frame.width + kWorkgroup - 1) / kWorkgroup,
                 (frame.height + kWorkgroup - 1) / kWorkgroup, 1);
   timer->end(cmd);
-  record_readback(frame);
+  record_readback(frame, tables.image_to_host);
 }
 
 void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
@@ -241,10 +242,10 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
   m.write_descriptors();
   // Compiling the kernel is slow (seconds on lavapipe): the cache compiles each variant once.
   const VkPipeline pipeline = m.render_pipelines->get(m.render_variant(tables));
-  m.record_render(tables.frame, pipeline);
+  m.record_render(tables, pipeline);
   m.flush();
   invalidate(*m.ctx, m.readback);
-  m.read_results(tables.frame, result);
+  m.read_results(tables.frame, tables.image_to_host, result);
   result.stats.ms_render =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

@@ -2,6 +2,7 @@
 // kernel's per-pixel rays, the exact eye split and the sampling constants.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <glm/geometric.hpp>
@@ -192,6 +193,66 @@ TEST(FrameTables, StepFollowsTheFinestLevelAnySampleCanPick) {
   near.channels[0].coarsest_level = kMaxSceneLevel;
   EXPECT_EQ(
       step_level(build_frame_tables(near, fx.hierarchy, fx.layout, fx.channels), fx.hierarchy), 0u);
+}
+
+// Frame tables built into the same FrameTables frame after frame (as Renderer does) recompute a
+// LUT only where its transfer function changed, and equal a fresh build after every change: a
+// camera move, one transfer function, pre-integration on and off, a channel hidden and shown.
+TEST(FrameTables, ReusedTablesRecomputeOnlyChangedLutsAndEqualAFreshBuild) {
+  VolumeDesc v;
+  v.extent = {64, 48, 40};
+  v.channels = 3;
+  const BrickHierarchy hierarchy(v, BrickLayout{});
+  const OctreeLayout layout(v.extent, glm::uvec3(16));
+  PageTable pages(hierarchy, 3, 16);
+  ChannelMap channels(3, 3);
+  for (std::uint32_t c = 0; c < 3; ++c) channels.assign(c, c, pages);
+  Camera cam;
+  cam.eye = {1.8, 1.1, 1.6};
+  Scene s = scene_with(cam, {32, 24});
+  s.channels.clear();
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    ChannelSettings ch;
+    ch.channel = c;
+    ch.tf =
+        TransferFunction({{0.1 * c, {1, 0, 0, 0}}, {0.5 + 0.1 * c, {0, 1, 0.5, 0.3 + 0.2 * c}}});
+    s.channels.push_back(ch);
+  }
+  FrameTables reused;
+  const auto expect_fresh = [&](const char* step, std::uint32_t luts) {
+    build_frame_tables(s, hierarchy, layout, channels, {}, reused);
+    const FrameTables fresh = build_frame_tables(s, hierarchy, layout, channels, {});
+    EXPECT_EQ(reused.luts_built, luts) << step;
+    EXPECT_EQ(fresh.luts_built, std::uint32_t(s.channels.size())) << step;
+    EXPECT_EQ(reused.tf_luts, fresh.tf_luts) << step;
+    EXPECT_EQ(reused.preint_tables, fresh.preint_tables) << step;
+    ASSERT_EQ(reused.slots.size(), fresh.slots.size()) << step;
+    EXPECT_EQ(std::memcmp(reused.slots.data(), fresh.slots.data(),
+                          fresh.slots.size() * sizeof(kernel::ResoctSlotInfo)),
+              0)
+        << step;
+    EXPECT_EQ(std::memcmp(&reused.frame, &fresh.frame, sizeof(fresh.frame)), 0) << step;
+  };
+  expect_fresh("first build", 3);
+  s.camera.eye = {1.7, 1.2, 1.5};
+  expect_fresh("camera moved", 0);
+  s.channels[1].tf = TransferFunction({{0.2, {0, 0, 1, 0}}, {0.9, {1, 1, 1, 0.8}}});
+  expect_fresh("one transfer function changed", 1);
+  s.preintegration = true;
+  expect_fresh("pre-integration on", 0);
+  s.camera.eye = {1.6, 1.2, 1.5};
+  expect_fresh("camera moved with pre-integration", 0);
+  s.channels[0].tf = TransferFunction({{0.0, {1, 1, 0, 0}}, {1.0, {1, 1, 0, 0.5}}});
+  expect_fresh("transfer function changed with pre-integration", 1);
+  const ChannelSettings hidden = s.channels[2];
+  s.channels.pop_back();
+  expect_fresh("channel 2 hidden", 0);
+  EXPECT_FALSE(reused.lut_sources[2].has_value());
+  s.channels.push_back(hidden);
+  expect_fresh("channel 2 shown again", 1);
+  s.preintegration = false;
+  expect_fresh("pre-integration off", 0);
+  EXPECT_TRUE(reused.preint_tables.empty());
 }
 
 }  // namespace

@@ -35,6 +35,8 @@ class ErrorTest(unittest.TestCase):
                           source, host_eviction="fifo")
         self.assert_error("invalid_argument", "parameter 'output'", resoct.Renderer, source,
                           output="rgb")
+        self.assert_error("invalid_argument", "GPU memory", resoct.Renderer, source,
+                          output="device")
         self.assert_error("invalid_argument", "parameter 'device_cache_mb'", resoct.Renderer,
                           source, device_cache_mb=0)
         self.assert_error("invalid_argument", "parameter 'backend'", resoct.Renderer, source,

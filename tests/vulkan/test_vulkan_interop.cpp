@@ -3,6 +3,7 @@
 // backend like the self-created backend does, alone and as a Renderer's backend object.
 #include <atomic>
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -108,6 +109,82 @@ void create_app_device(AppDevice& d) {
   ASSERT_EQ(vkCreateDevice(d.physical, &dci, nullptr, &d.device), VK_SUCCESS);
 }
 
+// What an application does with FrameOutput::device: records its own copy of the frame's device
+// buffer into host-visible memory on queue 0 of its family, behind the barrier DeviceImage asks
+// for, and reads it. A failed step is a fatal failure of the calling test.
+void copy_device_image(const AppDevice& d, const DeviceImage& image, std::vector<glm::vec4>& out) {
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = image.bytes;
+  bci.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  VkBuffer host = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateBuffer(d.device, &bci, nullptr, &host), VK_SUCCESS);
+  VkMemoryRequirements req{};
+  vkGetBufferMemoryRequirements(d.device, host, &req);
+  VkPhysicalDeviceMemoryProperties mp{};
+  vkGetPhysicalDeviceMemoryProperties(d.physical, &mp);
+  const VkMemoryPropertyFlags want =
+      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  std::uint32_t type = 0;
+  while (type < mp.memoryTypeCount && (((req.memoryTypeBits >> type) & 1u) == 0 ||
+                                       (mp.memoryTypes[type].propertyFlags & want) != want)) {
+    ++type;
+  }
+  ASSERT_LT(type, mp.memoryTypeCount);
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = type;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateMemory(d.device, &mai, nullptr, &memory), VK_SUCCESS);
+  ASSERT_EQ(vkBindBufferMemory(d.device, host, memory, 0), VK_SUCCESS);
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.queueFamilyIndex = d.family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateCommandPool(d.device, &pci, nullptr, &pool), VK_SUCCESS);
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  ASSERT_EQ(vkAllocateCommandBuffers(d.device, &cai, &cmd), VK_SUCCESS);
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  ASSERT_EQ(vkBeginCommandBuffer(cmd, &begin), VK_SUCCESS);
+  VkBufferMemoryBarrier from_kernel{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+  from_kernel.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  from_kernel.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  from_kernel.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  from_kernel.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  from_kernel.buffer = vk::buffer_of(image);
+  from_kernel.offset = image.offset;
+  from_kernel.size = image.bytes;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                       0, nullptr, 1, &from_kernel, 0, nullptr);
+  const VkBufferCopy region{image.offset, 0, image.bytes};
+  vkCmdCopyBuffer(cmd, vk::buffer_of(image), host, 1, &region);
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
+  ASSERT_EQ(vkEndCommandBuffer(cmd), VK_SUCCESS);
+  VkQueue queue = VK_NULL_HANDLE;
+  vkGetDeviceQueue(d.device, d.family, 0, &queue);
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  ASSERT_EQ(vkQueueSubmit(queue, 1, &si, VK_NULL_HANDLE), VK_SUCCESS);
+  ASSERT_EQ(vkQueueWaitIdle(queue), VK_SUCCESS);
+  void* mapped = nullptr;
+  ASSERT_EQ(vkMapMemory(d.device, memory, 0, image.bytes, 0, &mapped), VK_SUCCESS);
+  out.resize(std::size_t(image.bytes / sizeof(glm::vec4)));
+  std::memcpy(out.data(), mapped, std::size_t(image.bytes));
+  vkUnmapMemory(d.device, memory);
+  vkDestroyCommandPool(d.device, pool, nullptr);
+  vkDestroyBuffer(d.device, host, nullptr);
+  vkFreeMemory(d.device, memory, nullptr);
+}
+
 // Tests that render on an application's device open it first; TearDown then checks that the
 // backend left the caller's handles usable and the validation layer silent.
 class VulkanInterop : public ::testing::Test {
@@ -171,6 +248,51 @@ TEST_F(VulkanInterop, RendererTakesAnApplicationDeviceBackend) {
   EXPECT_EQ(a.last.stats.backend.samples, b.last.stats.backend.samples);
   const ImageDiff diff = compare_images(a.last.image, b.last.image);
   for (int c = 0; c < 4; ++c) EXPECT_LE(diff.max_abs[c], kVulkanColourTolerance) << c;
+}
+
+// FrameOutput::device: the converged frame stays in the backend's buffer (no image, no 8-bit
+// pixels on the host), and what the application copies out of it equals, bit for bit, the image
+// a read-back renderer on the same device returns.
+TEST_F(VulkanInterop, DeviceOutputStaysOnTheDeviceAndEqualsTheReadBack) {
+  open_device();
+  if (IsSkipped() || HasFatalFailure()) return;
+  const std::shared_ptr<const BrickSource> src =
+      make_procedural_source("procedural:tubes:48x48x48", BrickLayout{glm::uvec3(16), 1});
+  const Scene scene = overview_scene(src->hierarchy().volume(), Viewport{40, 32});
+  ViewerOptions o;
+  o.loader_threads = 0;
+  ViewerOptions on_device_options = o;
+  on_device_options.output = FrameOutput::device;
+  Renderer read_back(src, vk::make_backend(app_.instance, app_.physical, app_.device, app_.family),
+                     o);
+  Renderer on_device(src, vk::make_backend(app_.instance, app_.physical, app_.device, app_.family),
+                     on_device_options);
+  const ConvergeReport a = read_back.render_until_converged(scene, 64);
+  const ConvergeReport b = on_device.render_until_converged(scene, 64);
+  ASSERT_TRUE(a.converged);
+  ASSERT_TRUE(b.converged);
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_EQ(a.last.device_image.handle, 0u);
+  const FrameReport& f = b.last;
+  EXPECT_EQ(f.width, 40u);
+  EXPECT_EQ(f.height, 32u);
+  EXPECT_EQ(f.image.width(), 0u);
+  EXPECT_TRUE(f.image.pixels().empty());
+  EXPECT_TRUE(f.rgba8.empty());
+  ASSERT_NE(f.device_image.handle, 0u);
+  EXPECT_EQ(f.device_image.width, 40u);
+  EXPECT_EQ(f.device_image.height, 32u);
+  EXPECT_EQ(f.device_image.bytes, 40u * 32u * sizeof(glm::vec4));
+  EXPECT_EQ(vk::handle_of(vk::buffer_of(f.device_image)), f.device_image.handle);
+  EXPECT_EQ(f.stats.backend.samples, a.last.stats.backend.samples);
+  std::vector<glm::vec4> pixels;
+  copy_device_image(app_, f.device_image, pixels);
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(pixels.size(), a.last.image.pixels().size());
+  EXPECT_EQ(
+      std::memcmp(pixels.data(), a.last.image.pixels().data(), pixels.size() * sizeof(glm::vec4)),
+      0);
+  EXPECT_GT(a.last.image.at(20, 16).a, 0.0f);
 }
 
 TEST_F(VulkanInterop, NullHandlesAreRejected) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -23,6 +24,7 @@
 #include "resoct/engine/page_table.hpp"
 #include "resoct/engine/request_set.hpp"
 #include "resoct/engine/residency_octree.hpp"
+#include "resoct/scene/transfer_function.hpp"
 #include "resoct/volume/voxel_type.hpp"
 
 namespace resoct {
@@ -89,6 +91,19 @@ struct FrameTables {
   /// With RESOCT_EFFECT_PREINT in fx.effects: page_slot_count * 2 * RESOCT_TF_LUT_SIZE entries,
   /// indexed by slot (preintegration_table(), kernel/preintegration.glsl.h); else empty.
   std::vector<glm::vec4> preint_tables;
+  /// What build_frame_tables() built tf_luts and preint_tables from, so that a build into the
+  /// same tables recomputes only what changed (a camera move recomputes no LUT). Per page slot:
+  /// the transfer function whose LUT tf_luts holds (none: the LUT is zero), and whether
+  /// preint_tables holds that LUT's pre-integration table. Backends do not read these.
+  std::vector<std::optional<TransferFunction>> lut_sources;
+  std::vector<std::uint8_t> preint_built;
+  /// Transfer-function LUTs the last build computed; the other slots' LUTs were kept.
+  std::uint32_t luts_built = 0;
+  /// Whether render() must copy the image into host memory (FrameResult::image). When false, a
+  /// backend that renders into device memory leaves the pixels there, describes them in
+  /// FrameResult::device_image and leaves FrameResult::image as it was; a backend that renders
+  /// in host memory (the CPU backend) fills FrameResult::image anyway.
+  bool image_to_host = true;
 };
 
 /// Per-frame statistics a backend reports (sums over rays).
@@ -109,9 +124,28 @@ struct BackendStats {
   double ms_device = 0.0;            ///< device time where measurable (timestamp queries), else 0
 };
 
+/// A frame's image left in device memory (FrameTables::image_to_host = false), for an
+/// application that displays it without a copy to the host. Pixels as FrameResult::image would
+/// hold them: RGBA float32 (16 bytes per pixel, straight alpha over the background), row-major,
+/// row 0 at the top, no padding between rows. Vulkan: `handle` is the VkBuffer (a storage buffer
+/// usable as a transfer source, exclusive to the backend's queue family); the frame's writes are
+/// complete when render() returns, and a command buffer that reads them needs a barrier from
+/// VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT / VK_ACCESS_SHADER_WRITE_BIT first. The buffer is the
+/// backend's: valid until its next render() or configure(), which may write or replace it.
+struct DeviceImage {
+  std::uint64_t handle = 0;  ///< backend-specific buffer handle; 0 when the image is on the host
+  std::uint64_t offset = 0;  ///< bytes from the buffer's start to pixel (0, 0)
+  std::uint64_t bytes = 0;   ///< width * height * 16
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+};
+
 /// What render() returns.
 struct FrameResult {
   Image image;  ///< RGBA over the background, stored straight (docs/rendering.md "Compositing")
+  /// Where the image stays on the device (FrameTables::image_to_host = false on a device
+  /// backend); handle 0 otherwise.
+  DeviceImage device_image;
   /// Device request keys (PageTable::device_key) + hits. Keys name pool blocks, not levels, so
   /// every brick request carries level 0 (the loader orders loads by the decoded brick).
   std::vector<Request> brick_requests;

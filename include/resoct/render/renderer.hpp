@@ -36,11 +36,15 @@ namespace resoct {
 struct FrameReport {
   std::uint32_t width = 0;  ///< the frame's size, whichever output it carries
   std::uint32_t height = 0;
-  /// Float RGBA, straight alpha (ViewerOptions::output rgba32f or both; else empty).
+  /// Float RGBA, straight alpha (ViewerOptions::output rgba32f or both, or device on the CPU
+  /// backend; else empty).
   Image image;
   /// 8-bit RGBA, 4 bytes per pixel, row 0 at the top, as Image::to_rgba8 (output rgba8 or both;
   /// else empty).
   std::vector<std::uint8_t> rgba8;
+  /// With output device on a device backend: the frame's float image in device memory, valid
+  /// until the next frame (DeviceImage in backend.hpp says how to read it); handle 0 otherwise.
+  DeviceImage device_image;
   /// True when the frame needed nothing it did not have: no brick or node requests other than
   /// for bricks that failed to load, no dropped requests, nothing queued, loading or waiting.
   bool converged = false;

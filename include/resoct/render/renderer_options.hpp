@@ -43,8 +43,13 @@ enum class FrameOutput : std::uint8_t {
   rgba32f,  ///< FrameReport::image only
   rgba8,    ///< FrameReport::rgba8 only (FrameReport::image stays empty)
   both,     ///< both
+  /// The float image stays where the backend rendered it: on a device backend (Vulkan) in device
+  /// memory, described by FrameReport::device_image, with no copy to the host
+  /// (FrameReport::image and ::rgba8 stay empty); on the CPU backend, whose device is the host,
+  /// as rgba32f in FrameReport::image.
+  device,
 };
-/// "rgba32f" / "rgba8" / "both".
+/// "rgba32f" / "rgba8" / "both" / "device".
 const char* to_string(FrameOutput o) noexcept;
 /// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
 FrameOutput parse_frame_output(std::string_view s, std::string_view parameter = "output");

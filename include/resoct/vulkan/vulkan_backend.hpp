@@ -30,6 +30,11 @@ std::unique_ptr<Backend> make_backend(const BackendOptions& options = {});
 std::unique_ptr<Backend> make_backend(VkInstance instance, VkPhysicalDevice physical,
                                       VkDevice device, std::uint32_t queue_family);
 
+/// The VkBuffer of an image a frame left on the device (FrameReport::device_image with output
+/// FrameOutput::device; VK_NULL_HANDLE when its handle is 0), and the inverse.
+VkBuffer buffer_of(const DeviceImage& image) noexcept;
+std::uint64_t handle_of(VkBuffer buffer) noexcept;
+
 /// Registers the backend under the name "vulkan" (idempotent, thread-safe), for name-based
 /// creation (RendererOptions::backend). The factory honours BackendOptions::device and
 /// ::validation.

@@ -27,8 +27,10 @@ constexpr Choice<RequestStrategy> kStrategies[] = {{"greedy", RequestStrategy::g
                                                    {"global", RequestStrategy::global}};
 constexpr Choice<Eviction> kEvictions[] = {{"lru", Eviction::lru},
                                            {"octreemizer", Eviction::octreemizer}};
-constexpr Choice<FrameOutput> kOutputs[] = {
-    {"rgba32f", FrameOutput::rgba32f}, {"rgba8", FrameOutput::rgba8}, {"both", FrameOutput::both}};
+constexpr Choice<FrameOutput> kOutputs[] = {{"rgba32f", FrameOutput::rgba32f},
+                                            {"rgba8", FrameOutput::rgba8},
+                                            {"both", FrameOutput::both},
+                                            {"device", FrameOutput::device}};
 
 // "unknown" for a value outside the table (an enum made by a cast from a bad integer), which
 // ViewerOptions::validate() reports.

@@ -5,7 +5,10 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -119,7 +122,7 @@ void fill_effects(const Scene& scene, const BrickHierarchy& h, kernel::ResoctFxF
 // The slot's mode, isovalues and the visible range the node culling tests (projection.glsl.h).
 // Whether the kernel's LUT lookup (kernel/tf.glsl.h) can give raw value 0 any opacity: both LUT
 // entries it interpolates between are tested, so the answer is conservative.
-void fill_slot_zero(const ChannelSettings& c, const std::vector<glm::vec4>& lut,
+void fill_slot_zero(const ChannelSettings& c, std::span<const glm::vec4> lut,
                     kernel::ResoctSlotInfo& s) {
   s.zero_value = (0.0f - s.range_lo) * s.inv_range_width;  // resoct_normalize_value(0)
   s.zero_visible = 0u;
@@ -263,11 +266,25 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   });
 
   out.slots.clear();
-  out.tf_luts.assign(std::size_t(channels.slot_count()) * kTfLutSize, glm::vec4(0.0f));
-  out.preint_tables.clear();
-  if (scene.preintegration) {
-    out.preint_tables.assign(std::size_t(channels.slot_count()) * 2u * kTfLutSize, glm::vec4(0.0f));
+  // LUTs and pre-integration tables are kept from the previous build into `out` where their
+  // transfer function is unchanged: the tables then equal a fresh build's, without the work.
+  const std::uint32_t slot_count = channels.slot_count();
+  const std::size_t lut_entries = std::size_t(slot_count) * kTfLutSize;
+  if (out.tf_luts.size() != lut_entries || out.lut_sources.size() != slot_count ||
+      out.preint_built.size() != slot_count) {
+    out.tf_luts.assign(lut_entries, glm::vec4(0.0f));
+    out.lut_sources.assign(slot_count, std::nullopt);
+    out.preint_built.assign(slot_count, 0u);
   }
+  if (!scene.preintegration) {
+    out.preint_tables.clear();
+    std::fill(out.preint_built.begin(), out.preint_built.end(), std::uint8_t(0));
+  } else if (out.preint_tables.size() != 2u * lut_entries) {
+    out.preint_tables.assign(2u * lut_entries, glm::vec4(0.0f));
+    std::fill(out.preint_built.begin(), out.preint_built.end(), std::uint8_t(0));
+  }
+  out.luts_built = 0;
+  std::vector<bool> slot_used(slot_count, false);
   // The step (Eq. 8.2-8.3) follows the finest level any sample of a channel can use: its finest
   // allowed level, or the level the LOD picks at the volume's nearest point when that is
   // coarser. Without the LOD floor a distant view of a huge volume would march level-0 steps
@@ -298,21 +315,43 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     s.range_lo = float(r.lo);
     s.inv_range_width = float(1.0 / (r.hi - r.lo));
     fill_slot_effects(c, s);
-    const std::vector<glm::vec4> lut = c.tf.lut(kTfLutSize);
+    const std::span<glm::vec4> lut(out.tf_luts.data() + std::size_t(*slot) * kTfLutSize,
+                                   kTfLutSize);
+    std::optional<TransferFunction>& built_from = out.lut_sources[*slot];
+    if (!built_from || !(*built_from == c.tf)) {
+      const std::vector<glm::vec4> fresh = c.tf.lut(kTfLutSize);
+      std::copy(fresh.begin(), fresh.end(), lut.begin());
+      built_from = c.tf;
+      out.preint_built[*slot] = 0u;
+      ++out.luts_built;
+    }
+    slot_used[*slot] = true;
     fill_slot_zero(c, lut, s);
     out.slots.push_back(s);
 
-    std::copy(lut.begin(), lut.end(), out.tf_luts.begin() + std::ptrdiff_t(*slot) * kTfLutSize);
-    if (scene.preintegration) {
+    if (scene.preintegration && out.preint_built[*slot] == 0u) {
       const std::vector<glm::vec4> pre = preintegration_table(lut);
       std::copy(pre.begin(), pre.end(),
                 out.preint_tables.begin() + std::ptrdiff_t(*slot) * 2 * kTfLutSize);
+      out.preint_built[*slot] = 1u;
     }
     const std::uint32_t step_level =
         std::min(std::max(lod_floor, s.finest_level), s.coarsest_level);
     finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, step_level));
   }
   if (scene.channels.empty()) finest_voxel = box_voxel_size(volume);
+  // Slots this scene does not show read as zero, as in a fresh build.
+  for (std::uint32_t slot = 0; slot < slot_count; ++slot) {
+    if (slot_used[slot] || !out.lut_sources[slot]) continue;
+    const auto first = out.tf_luts.begin() + std::ptrdiff_t(slot) * kTfLutSize;
+    std::fill(first, first + kTfLutSize, glm::vec4(0.0f));
+    if (!out.preint_tables.empty()) {
+      const auto pre = out.preint_tables.begin() + std::ptrdiff_t(slot) * 2 * kTfLutSize;
+      std::fill(pre, pre + 2 * kTfLutSize, glm::vec4(0.0f));
+    }
+    out.lut_sources[slot].reset();
+    out.preint_built[slot] = 0u;
+  }
 
   const double ref = reference_step_length(volume);
   f.finest_voxel_x = float(finest_voxel.x);

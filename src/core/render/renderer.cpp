@@ -487,8 +487,10 @@ const FrameTables& Renderer::frame_tables(const Scene& scene) {
   fo.request_strategy = options_.strategy;
   fo.start_depth = options_.start_depth;
   fo.max_iterations = options_.max_iterations;
-  // Rebuilt every frame (camera and TFs change) into the same vectors: no per-frame allocation.
+  // Rebuilt every frame into the same tables: no per-frame allocation, and only the LUTs of
+  // transfer functions that changed are computed again (FrameTables::lut_sources).
   build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
+  tables_.image_to_host = options_.output != FrameOutput::device;
   return tables_;
 }
 
@@ -500,9 +502,19 @@ FrameReport Renderer::render_frame(const Scene& scene) {
 
 void Renderer::take_pixels(FrameReport& report) {
   const Image& rendered = result_.image;
+  report.device_image = result_.device_image;
+  if (result_.device_image.handle != 0) {
+    // Output device on a device backend: the pixels stay there; nothing is copied.
+    report.width = result_.device_image.width;
+    report.height = result_.device_image.height;
+    report.image = Image();
+    report.rgba8.clear();
+    return;
+  }
   report.width = rendered.width();
   report.height = rendered.height();
-  if (options_.output == FrameOutput::rgba32f) {
+  // Output device on a host backend (CPU) gives the float image, as rgba32f does.
+  if (options_.output == FrameOutput::rgba32f || options_.output == FrameOutput::device) {
     report.rgba8.clear();
   } else {
     rendered.to_rgba8(report.rgba8);

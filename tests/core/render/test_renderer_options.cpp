@@ -17,7 +17,8 @@ TEST(RendererOptions, ChoiceNamesRoundTrip) {
   for (const auto e : {Eviction::lru, Eviction::octreemizer}) {
     EXPECT_EQ(parse_eviction(to_string(e)), e);
   }
-  for (const auto o : {FrameOutput::rgba32f, FrameOutput::rgba8, FrameOutput::both}) {
+  for (const auto o :
+       {FrameOutput::rgba32f, FrameOutput::rgba8, FrameOutput::both, FrameOutput::device}) {
     EXPECT_EQ(parse_frame_output(to_string(o)), o);
   }
   for (const auto m : {RenderMode::residency, RenderMode::pagetable, RenderMode::octree}) {
