@@ -19,7 +19,7 @@
 #include "resoct/base/file_io.hpp"
 #include "resoct/io/http/http_store.hpp"
 #include "resoct/sources/procedural_source.hpp"
-#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/open_random_access_file.hpp"
 #include "support/http_test_server.hpp"
 
 using namespace resoct;

@@ -12,7 +12,7 @@
 // for any L (no 2D table). Values outside [0, 1] take the end knots' τ and w, as point lookups
 // clamp; the average then weighs the parts outside [0, 1] by their length in value.
 //
-// Tables (host: resoct::preintegration_table, src/core/preintegration.cpp), 2N vec4 per slot:
+// Tables (host: resoct::preintegration_table, src/core/scene/preintegration.cpp), 2N vec4 per slot:
 //   entry i        k_i = (w_i, τ_i)                       the knots
 //   entry N + i    C_i = Σ_{m<i} (k_m + k_{m+1}) / 2       exact cumulative integral in bin units
 // Integrals are evaluated as a tail in the first bin, whole bins C_j − C_{i+1} and a head in the

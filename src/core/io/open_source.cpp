@@ -20,7 +20,7 @@
 #include "resoct/io/formats/tiff_stack.hpp"
 #include "resoct/io/http/http_store.hpp"
 #include "resoct/sources/procedural_source.hpp"
-#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/open_random_access_file.hpp"
 #include "resoct/io/http/s3_store.hpp"
 #include "resoct/io/store/format.hpp"
 

@@ -1,4 +1,4 @@
-#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/open_random_access_file.hpp"
 
 #include <cctype>
 #include <limits>

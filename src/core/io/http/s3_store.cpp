@@ -2,7 +2,7 @@
 // bucket's address (s3_bucket_url) plus the spec's key prefix, with SigV4 signing on.
 #include "io/http/percent_encoding.hpp"
 #include "resoct/base/error.hpp"
-#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/open_random_access_file.hpp"
 #include "resoct/io/http/s3_store.hpp"
 
 namespace resoct {

@@ -10,7 +10,7 @@
 #include "resoct/io/store/brick_store.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/io/http/http_store.hpp"
-#include "resoct/base/random_access_file.hpp"
+#include "resoct/io/http/open_random_access_file.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "support/brick_compare.hpp"
