@@ -1,8 +1,8 @@
 // resoct single-source kernel: the per-frame records every backend hands to the traversal.
 //
 // All records are structs of 4-byte scalars only, so their std430 layout equals the C++ layout
-// (no vec3 padding). The host fills them (src/core/render/frame_tables.cpp); the CPU backend reads them
-// directly, the Vulkan backend uploads them to storage buffers.
+// (no vec3 padding). The host fills them (src/core/render/frame_tables.cpp); the CPU backend reads
+// them directly, the Vulkan backend uploads them to storage buffers.
 //
 // Coordinate systems (see docs/rendering.md):
 //   box space      the volume's normalized physical box: min corner at the origin, the longest

@@ -6,8 +6,8 @@
 // (request_key.glsl.h), the transfer-function LUT size (tf.glsl.h) and the (index, value) delta
 // pairs (PageDelta, OctreeWordDelta). A backend compiled against one layout misreads the tables of
 // another, so whoever changes a record's size, field order or encoding increments this number;
-// tests/core/kernel/test_kernel_layout_version.cpp pins what version N means and fails until both agree.
-// Applications compare it with resoct::library_kernel_layout_version() (resoct/version.hpp).
+// tests/core/kernel/test_kernel_layout_version.cpp pins what version N means and fails until both
+// agree. Applications compare it with resoct::library_kernel_layout_version() (resoct/version.hpp).
 #ifndef RESOCT_KERNEL_LAYOUT_VERSION_GLSL_H
 #define RESOCT_KERNEL_LAYOUT_VERSION_GLSL_H
 
