@@ -18,6 +18,7 @@
 #include "resoct/base/file_io.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/scene/overview_scene.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/cli_parse.hpp"
 #include "support/source_options.hpp"
@@ -103,7 +104,7 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   const FrameStats& s = last.stats;
   nlohmann::json j;
   j["volume"] = a.volume;
-  j["scene"] = a.scene;
+  j["scene"] = a.scene.empty() ? std::string("overview") : a.scene;
   j["backend"] = a.backend;
   j["mode"] = a.mode;
   j["strategy"] = a.strategy;
@@ -183,7 +184,6 @@ int run(const Args& a) {
   if (a.list_devices) throw invalid_parameter("list-devices", "this build has no Vulkan backend");
 #endif
   if (a.volume.empty()) throw invalid_parameter("volume", "--volume is required");
-  if (a.scene.empty()) throw invalid_parameter("scene", "--scene is required");
   resoct::cpu::register_backend();
   RendererOptions o;
   o.backend = a.backend;
@@ -217,10 +217,15 @@ int run(const Args& a) {
   }
   if (!a.stats.empty()) resoct::tools::check_output_path("stats", a.stats);
 
-  Scene scene = load_scene(a.scene);
+  // A scene file is read before the volume is opened, so that a bad one fails at once.
+  std::optional<Scene> from_file;
+  if (!a.scene.empty()) from_file = load_scene(a.scene);
+  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
+  // Without --scene, the volume's overview: the whole box in view, up to four channels in
+  // distinct colours, each a ramp over its value range (overview_scene.hpp).
+  Scene scene = from_file ? *from_file : overview_scene(renderer.hierarchy().volume());
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
-  Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
   // Checked before rendering, naming the option rather than the scene field.
   const std::uint32_t timepoints = renderer.timepoints();
   const auto check_timepoint = [&](const char* option, std::uint32_t t) {
@@ -328,7 +333,9 @@ int main(int argc, char** argv) {
   Args a;
   app.add_option("--volume", a.volume, std::string(kSourceSpecForms) + " (required)");
   resoct::tools::add_source_options(app, a.source);
-  app.add_option("--scene", a.scene, "scene JSON (docs/scene.md) (required)");
+  app.add_option("--scene", a.scene,
+                 "scene JSON (docs/scene.md); without it, an overview of the whole volume "
+                 "(up to 4 channels, each a colour ramp over its value range)");
   app.add_option("--backend", a.backend, "cpu | vulkan (when built) | registered backend name")
       ->capture_default_str();
   app.add_option("--device", a.device, "Vulkan device index or name substring");

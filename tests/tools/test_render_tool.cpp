@@ -81,6 +81,28 @@ TEST(RenderTool, RendersAStoreWrittenByConvert) {
   EXPECT_EQ(resoct::read_png(png).width(), 40u);
 }
 
+// Without --scene the tool renders the volume's overview (overview_scene): converged, a picture
+// with the channels' colours, and "overview" as the scene in stats.json.
+TEST(RenderTool, RendersTheOverviewWithoutAScene) {
+  TempDir dir;
+  const std::string png = dir.file("overview.png"), stats = dir.file("overview.json");
+  const ToolRun r = run(dir, RESOCT_RENDER,
+                        "--volume procedural:tubes:64x64x64 --width 40 --height 32 --converge "
+                        "--threads 1 --out '" +
+                            png + "' --stats '" + stats + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const resoct::Image img = resoct::read_png(png);
+  ASSERT_EQ(img.width(), 40u);
+  ASSERT_EQ(img.height(), 32u);
+  std::size_t lit = 0;
+  for (const glm::vec4& p : img.pixels()) lit += p.r + p.g + p.b > 0.1f ? 1u : 0u;
+  EXPECT_GT(lit, 20u) << "the tubes must show";
+  const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+  EXPECT_EQ(j["scene"], "overview");
+  EXPECT_TRUE(j["converged"].get<bool>());
+  EXPECT_GT(j["samples_per_ray"].get<double>(), 0.0);
+}
+
 // examples/scenes/slices.json: a window/level slice at z = 0.3 faces the camera; the voxels
 // there are mostly 0, which the window shows as grey 0.3 (opaque), unlike the bluish background.
 TEST(RenderTool, RendersSlicesAndLens) {
