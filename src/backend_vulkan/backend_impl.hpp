@@ -159,8 +159,10 @@ struct VulkanBackend::Impl {
   void upload_tables(const FrameTables& tables);
   /// Records clearing the per-frame outputs, the dispatch and the barriers around it.
   void record_render(const FrameTables& tables, VkPipeline pipeline);
-  /// Where a frame of `pixels` pixels puts its outputs in the readback buffer.
-  detail::ReadbackLayout readback_layout(std::size_t pixels) const;
+  /// Where a frame puts its outputs in the readback buffer: its image (none when the image stays
+  /// on the device), then requests, used bits and statistics.
+  detail::ReadbackLayout readback_layout(const kernel::ResoctFrame& frame,
+                                         bool image_to_host) const;
   /// Ends an unsubmitted batch without running it (configure() replaces all state anyway).
   void discard_batch() noexcept;
   /// Records copying the frame's outputs (image unless it stays on the device, statistics,

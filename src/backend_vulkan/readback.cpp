@@ -58,20 +58,21 @@ ReadbackLayout detail::readback_layout(std::size_t pixels, std::uint32_t brick_c
   return l;
 }
 
-ReadbackLayout VulkanBackend::Impl::readback_layout(std::size_t pixels) const {
+ReadbackLayout VulkanBackend::Impl::readback_layout(const kernel::ResoctFrame& frame,
+                                                    bool image_to_host) const {
+  const std::size_t pixels = image_to_host ? std::size_t(frame.width) * frame.height : 0;
   return detail::readback_layout(pixels, brick_capacity, node_capacity, config.cache_slots);
 }
 
 void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame, bool image_to_host) {
-  const ReadbackLayout l = readback_layout(std::size_t(frame.width) * frame.height);
+  const ReadbackLayout l = readback_layout(frame, image_to_host);
   barrier();
   auto copy = [&](Binding b, VkDeviceSize to, VkDeviceSize bytes) {
     if (bytes == 0) return;
     const VkBufferCopy region{0, to, bytes};
     vkCmdCopyBuffer(cmd, buf[b].buffer, readback.buffer, 1, &region);
   };
-  // An image that stays on the device (FrameTables::image_to_host false) is not copied.
-  if (image_to_host) copy(b_out, l.image, l.brick_requests - l.image);
+  copy(b_out, l.image, l.brick_requests - l.image);  // 0 bytes when the image stays on the device
   copy(b_brick_requests, l.brick_requests, l.node_requests - l.brick_requests);
   copy(b_node_requests, l.node_requests, l.used - l.node_requests);
   copy(b_used, l.used, l.stats - l.used);
@@ -86,7 +87,7 @@ void VulkanBackend::Impl::record_readback(const kernel::ResoctFrame& frame, bool
 void VulkanBackend::Impl::read_results(const kernel::ResoctFrame& frame, bool image_to_host,
                                        FrameResult& result) const {
   const std::size_t pixels = std::size_t(frame.width) * frame.height;
-  const ReadbackLayout l = readback_layout(pixels);
+  const ReadbackLayout l = readback_layout(frame, image_to_host);
   const auto* base = static_cast<const std::byte*>(readback.mapped);
   if (image_to_host) {
     if (result.image.width() != frame.width || result.image.height() != frame.height) {

@@ -237,7 +237,7 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
   Impl& m = *impl_;
   if (!m.configured) throw invalid_parameter("tables", "backend is not configured");
   check_frame_tables(tables, m.config);
-  m.ensure_readback(m.readback_layout(std::size_t(tables.frame.width) * tables.frame.height).total);
+  m.ensure_readback(m.readback_layout(tables.frame, tables.image_to_host).total);
   m.upload_tables(tables);
   m.write_descriptors();
   // Compiling the kernel is slow (seconds on lavapipe): the cache compiles each variant once.

@@ -14,7 +14,6 @@
 #include "support/expect_error.hpp"
 #include "support/sanitized.hpp"
 
-#if !RESOCT_TEST_SANITIZED
 // Counts the allocations of the sizes of a frame's pixel buffers while `g_counting` is set: a
 // frame that allocates image memory shows up here whatever container made the allocation.
 namespace {
@@ -24,6 +23,9 @@ std::atomic<std::size_t> g_rgba8_bytes{0};
 std::atomic<std::uint64_t> g_image_allocations{0};
 }  // namespace
 
+// A sanitizer's runtime defines operator new itself (a second definition does not link): there
+// nothing is counted, and the test that counts skips.
+#if !RESOCT_TEST_SANITIZED
 void* operator new(std::size_t n) {
   if (g_counting.load(std::memory_order_relaxed) &&
       (n == g_float_bytes.load(std::memory_order_relaxed) ||
@@ -39,15 +41,6 @@ void operator delete(void* p) noexcept {
 void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
-#else
-// A sanitizer's runtime defines operator new itself (a second definition does not link), so
-// nothing is counted and the test that counts skips.
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_float_bytes{0};
-std::atomic<std::size_t> g_rgba8_bytes{0};
-std::atomic<std::uint64_t> g_image_allocations{0};
-}  // namespace
 #endif
 
 namespace resoct::test {

@@ -284,7 +284,6 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     std::fill(out.preint_built.begin(), out.preint_built.end(), std::uint8_t(0));
   }
   out.luts_built = 0;
-  std::vector<bool> slot_used(slot_count, false);
   // The step (Eq. 8.2-8.3) follows the finest level any sample of a channel can use: its finest
   // allowed level, or the level the LOD picks at the volume's nearest point when that is
   // coarser. Without the LOD floor a distant view of a huge volume would march level-0 steps
@@ -325,7 +324,6 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
       out.preint_built[*slot] = 0u;
       ++out.luts_built;
     }
-    slot_used[*slot] = true;
     fill_slot_zero(c, lut, s);
     out.slots.push_back(s);
 
@@ -340,9 +338,11 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     finest_voxel = glm::min(finest_voxel, level_voxel_size(hierarchy, step_level));
   }
   if (scene.channels.empty()) finest_voxel = box_voxel_size(volume);
-  // Slots this scene does not show read as zero, as in a fresh build.
+  // Slots this scene does not show (none of out.slots) read as zero, as in a fresh build.
   for (std::uint32_t slot = 0; slot < slot_count; ++slot) {
-    if (slot_used[slot] || !out.lut_sources[slot]) continue;
+    if (!out.lut_sources[slot]) continue;
+    const auto shown = [slot](const kernel::ResoctSlotInfo& s) { return s.slot == slot; };
+    if (std::any_of(out.slots.begin(), out.slots.end(), shown)) continue;
     const auto first = out.tf_luts.begin() + std::ptrdiff_t(slot) * kTfLutSize;
     std::fill(first, first + kTfLutSize, glm::vec4(0.0f));
     if (!out.preint_tables.empty()) {
