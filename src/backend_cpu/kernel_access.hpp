@@ -174,6 +174,9 @@ inline void resoct_mark_used(uint cache_slot) {
 
 }  // namespace resoct::kernel
 
+// The march's single-channel segment loop as packets of four samples (same arithmetic).
+#include "segment_packets.hpp"
+#define RESOCT_SEGMENT_SAMPLES ::resoct::cpu::detail::segment_samples_packets
 #include "resoct/kernel/traverse.glsl.h"
 
 namespace resoct::cpu::detail {

@@ -193,11 +193,12 @@ RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSource src, ivec
 /// Prepares a mapped source for resoct_source_sample_t along the ray origin_cell + origin_frac +
 /// t * dir_vox: the padded position is affine in t. The integer part of the offset from the brick
 /// is exact, so rounding is relative to the distance from the ray origin, as for positions.
-RESOCT_FN ResoctSource resoct_source_along_ray(ResoctSource src, ivec3 origin_cell,
-                                               vec3 origin_frac, vec3 dir_vox, uint halo) {
+/// In place: in C++ a by-value copy of the record, written back whole, made the store of the
+/// new fields and the reload of the record overlap (a store-forwarding stall at every decision).
+RESOCT_FN void resoct_source_along_ray(RESOCT_INOUT(ResoctSource) src, ivec3 origin_cell,
+                                       vec3 origin_frac, vec3 dir_vox, uint halo) {
   src.ray_base = (vec3(origin_cell - src.core_lo) + origin_frac) * src.scale + vec3(float(halo));
   src.ray_dir = dir_vox * src.scale;
-  return src;
 }
 
 /// resoct_source_sample at ray parameter t, after resoct_source_along_ray.

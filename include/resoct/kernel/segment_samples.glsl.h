@@ -85,4 +85,12 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
 
 RESOCT_KERNEL_END
 
+// The loop the march calls. A backend may replace it with an implementation of the same contract
+// and the same arithmetic per sample by defining RESOCT_SEGMENT_SAMPLES before including
+// traverse.glsl.h: the CPU backend runs packets of four samples
+// (src/backend_cpu/segment_packets.hpp).
+#ifndef RESOCT_SEGMENT_SAMPLES
+#define RESOCT_SEGMENT_SAMPLES resoct_segment_samples
+#endif
+
 #endif  // RESOCT_KERNEL_SEGMENT_SAMPLES_GLSL_H

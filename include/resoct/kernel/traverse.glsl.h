@@ -543,7 +543,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             have_seg = true;
             seg_values = 0u;
             for (uint c = 0u; c < n; ++c) {
-              src[c] = resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
+              resoct_source_along_ray(src[c], o_cell, o_frac, dir_vox, sp.halo);
               if (src[c].kind == RESOCT_CH_VALUE) seg_values = seg_values | (1u << c);
             }
           }
@@ -578,7 +578,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                  seg_next - tm >= RESOCT_SEGMENT_LOOP_MIN_STEPS * dt;
       }
       if (single) {
-        stop = resoct_segment_samples(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm, t,
+        stop = RESOCT_SEGMENT_SAMPLES(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm, t,
                                       acc, stats);
         if (stop) break;
         continue;

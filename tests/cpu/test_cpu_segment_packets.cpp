@@ -1,0 +1,169 @@
+// The CPU backend's segment loop in packets of four samples (src/backend_cpu/segment_packets.hpp)
+// against the single-source loop it replaces (kernel/segment_samples.glsl.h, which the Vulkan
+// backend runs): for random sources, rays, transfer functions, steps, ends and iteration caps,
+// both must return bit-identical results: saturation, t, the accumulated colour and every
+// statistic. A difference of one ulp anywhere would make images depend on the backend's loop.
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "kernel_access.hpp"
+
+namespace resoct::cpu::detail {
+// This executable's own copy of the backend's per-thread context pointer (the library's is
+// hidden); both loops below read the brick and the transfer function through it.
+__thread const KernelContext* t_ctx = nullptr;
+}  // namespace resoct::cpu::detail
+
+namespace {
+
+namespace k = resoct::kernel;
+using resoct::VoxelType;
+using resoct::cpu::detail::BrickGeometry;
+using resoct::cpu::detail::KernelContext;
+
+constexpr glm::ivec3 kPadded{10, 9, 7};  // not cubic: strides and clamps differ per axis
+
+struct Fixture {
+  std::vector<std::byte> cache;  // two slots
+  std::vector<glm::vec4> tf;     // two transfer-function slots
+  KernelContext ctx;
+};
+
+template <class T>
+Fixture make_fixture(std::mt19937& rng, VoxelType type) {
+  Fixture fx;
+  const std::size_t voxels = std::size_t(kPadded.x) * kPadded.y * kPadded.z;
+  fx.cache.resize(2 * voxels * sizeof(T));
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (std::size_t i = 0; i < 2 * voxels; ++i) {
+    T v;
+    if constexpr (std::is_same_v<T, float>) {
+      v = u(rng) * 300.0f - 20.0f;
+    } else {
+      v = T(rng() % (std::size_t(std::numeric_limits<T>::max()) + 1u));
+    }
+    std::memcpy(fx.cache.data() + i * sizeof(T), &v, sizeof(T));
+  }
+  // Transfer functions with every opacity regime of the correction: zero, tiny (series), large
+  // (libm), exactly one.
+  fx.tf.resize(2 * k::RESOCT_TF_LUT_SIZE);
+  for (glm::vec4& e : fx.tf) {
+    const float r = u(rng);
+    float a = r < 0.2f ? 0.0f : (r < 0.6f ? u(rng) * 0.05f : (r < 0.95f ? u(rng) : 1.0f));
+    e = glm::vec4(u(rng), u(rng), u(rng), a);
+  }
+  fx.ctx.cache = fx.cache.data();
+  fx.ctx.slot_voxels = voxels;
+  fx.ctx.type = type;
+  fx.ctx.geometry = BrickGeometry(kPadded);
+  fx.ctx.brick_bytes = voxels * sizeof(T);
+  fx.ctx.tf = fx.tf.data();
+  return fx;
+}
+
+struct Outcome {
+  bool saturated;
+  float t;
+  glm::vec4 acc;
+  k::ResoctRayStats stats;
+};
+
+void expect_identical(const Outcome& a, const Outcome& b, int c) {
+  ASSERT_EQ(a.saturated, b.saturated) << "case " << c;
+  ASSERT_EQ(std::bit_cast<std::uint32_t>(a.t), std::bit_cast<std::uint32_t>(b.t)) << "case " << c;
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(std::bit_cast<std::uint32_t>(a.acc[i]), std::bit_cast<std::uint32_t>(b.acc[i]))
+        << "case " << c << " component " << i;
+  }
+  ASSERT_EQ(a.stats.samples, b.stats.samples) << "case " << c;
+  ASSERT_EQ(a.stats.brick_accesses, b.stats.brick_accesses) << "case " << c;
+  ASSERT_EQ(a.stats.iterations, b.stats.iterations) << "case " << c;
+  ASSERT_EQ(std::bit_cast<std::uint32_t>(a.stats.marched),
+            std::bit_cast<std::uint32_t>(b.stats.marched))
+      << "case " << c;
+}
+
+// Runs `cases` random segments through both loops; returns how many ended by saturation, so
+// that the caller can check the cases cover both ends.
+template <class T>
+int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
+  std::mt19937 rng(seed);
+  Fixture fx = make_fixture<T>(rng, type);
+  resoct::cpu::detail::t_ctx = &fx.ctx;
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int saturated = 0;
+  for (int c = 0; c < cases; ++c) {
+    k::ResoctFrame f{};
+    f.ref_step = 0.002f + u(rng) * 0.01f;
+    f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
+    f.max_iterations = 40u + std::uint32_t(rng() % 200u);
+
+    k::ResoctSource src = k::resoct_source_of(k::RESOCT_CH_VALUE, u(rng) * 1.4f - 0.2f);
+    if (u(rng) < 0.05f) src.value = std::numeric_limits<float>::quiet_NaN();
+    src.tf_slot = std::uint32_t(rng() % 2u);
+    if (u(rng) < 0.85f) {
+      src.cache_slot = std::uint32_t(rng() % 2u);
+      const float hi = std::is_same_v<T, float> ? 250.0f : float(std::numeric_limits<T>::max());
+      src.range_lo = u(rng) * 0.2f * hi;
+      src.inv_range_width = 1.0f / (hi * (0.5f + u(rng)));
+      // Rays through, into and out of the padded brick (clamps on every side).
+      src.ray_base = glm::vec3(u(rng) * 14.0f - 2.0f, u(rng) * 13.0f - 2.0f, u(rng) * 11.0f - 2.0f);
+      src.ray_dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f)) *
+                    (20.0f + u(rng) * 200.0f);
+    }
+    const float dt = 0.001f + u(rng) * 0.01f;
+    const float t0 = u(rng) * 0.5f;
+    const float t_exit = t0 + dt * (0.5f + u(rng) * 60.0f);
+    const float seg_next = u(rng) < 0.5f ? t_exit + 1.0f : t0 + dt * (1.0f + u(rng) * 40.0f);
+    const float seg = k::resoct_segment_length(t0, dt, t_exit);
+    const float tm = t0 + 0.5f * seg;
+    if (!(t_exit - t0 > k::RESOCT_SEGMENT_EPS * dt) || !(tm < seg_next)) continue;
+
+    Outcome start{};
+    start.t = t0;
+    const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
+    start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
+    start.stats.samples = std::uint32_t(rng() % 100u);
+    start.stats.brick_accesses = std::uint32_t(rng() % 100u);
+    start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
+    start.stats.marched = u(rng);
+
+    Outcome scalar = start, packets = start;
+    scalar.saturated = k::resoct_segment_samples(f, src, dt, t_exit, seg_next, seg, tm, scalar.t,
+                                                 scalar.acc, scalar.stats);
+    packets.saturated = resoct::cpu::detail::segment_samples_packets(
+        f, src, dt, t_exit, seg_next, seg, tm, packets.t, packets.acc, packets.stats);
+    expect_identical(scalar, packets, c);
+    if (::testing::Test::HasFatalFailure()) break;
+    if (scalar.saturated) ++saturated;
+  }
+  resoct::cpu::detail::t_ctx = nullptr;
+  return saturated;
+}
+
+TEST(CpuSegmentPackets, U8BitIdenticalToTheSingleSourceLoop) {
+  const int saturated = compare_loops<std::uint8_t>(VoxelType::u8, 11u, 20000);
+  EXPECT_GT(saturated, 1000);
+  EXPECT_LT(saturated, 19000);
+}
+
+TEST(CpuSegmentPackets, U16BitIdenticalToTheSingleSourceLoop) {
+  const int saturated = compare_loops<std::uint16_t>(VoxelType::u16, 12u, 20000);
+  EXPECT_GT(saturated, 1000);
+  EXPECT_LT(saturated, 19000);
+}
+
+TEST(CpuSegmentPackets, F32BitIdenticalToTheSingleSourceLoop) {
+  const int saturated = compare_loops<float>(VoxelType::f32, 13u, 20000);
+  EXPECT_GT(saturated, 1000);
+  EXPECT_LT(saturated, 19000);
+}
+
+}  // namespace
