@@ -22,6 +22,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/loading_bench.hpp"
 #include "resoct/scene/scene.hpp"
 
@@ -120,8 +121,8 @@ void BM_PrefetchPath(benchmark::State& state) {
       std::this_thread::sleep_until(t0 + period);
     }
     converged += done ? 1 : 0;
-    prefetched += double(r.loader().stats().prefetched);
-    hits += double(r.loader().stats().prefetch_hits);
+    prefetched += double(inspect::loader(r).stats().prefetched);
+    hits += double(inspect::loader(r).stats().prefetch_hits);
   }
   const double n = double(state.iterations());
   state.counters["unconverged_on_path"] = unconverged / n;

@@ -22,6 +22,7 @@
 #include <benchmark/benchmark.h>
 
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/bench_rig.hpp"
 
 namespace {
@@ -139,7 +140,7 @@ void BM_LensPaging(benchmark::State& state) {
     benchmark::DoNotOptimize(rep.last.image.pixels().data());
     frames = rep.frames;
     paged = 0;
-    for (std::uint32_t e : renderer.page_table().pool()) {
+    for (std::uint32_t e : inspect::page_table(renderer).pool()) {
       if (kernel::resoct_page_state(e) != kernel::RESOCT_PAGE_STATE_UNMAPPED) ++paged;
     }
   }

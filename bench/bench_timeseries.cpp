@@ -28,6 +28,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/loading_bench.hpp"
 #include "resoct/scene/scene.hpp"
 
@@ -112,7 +113,7 @@ void BM_TimepointSwitch(benchmark::State& state) {
     show();
     for (std::uint32_t t = 1; t < timepoints; ++t) {
       scene.timepoint = t;
-      const std::uint64_t loads_before = r.loader().stats().loads;
+      const std::uint64_t loads_before = inspect::loader(r).stats().loads;
       std::uint32_t f = 0;
       bool done = false;
       while (!done && f < kMaxFrames) {
@@ -124,10 +125,10 @@ void BM_TimepointSwitch(benchmark::State& state) {
       switches += 1;
       converged += done ? 1 : 0;
       frames += double(f);
-      loads += double(r.loader().stats().loads - loads_before);
+      loads += double(inspect::loader(r).stats().loads - loads_before);
       show();
     }
-    hits += double(r.loader().stats().prefetch_hits);
+    hits += double(inspect::loader(r).stats().prefetch_hits);
   }
   const double n = std::max(1.0, switches);
   state.counters["frames_to_converge"] = frames / n;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/bench_rig.hpp"
 
 namespace resoct::bench {
@@ -26,7 +27,7 @@ ConvergeRun converge(std::shared_ptr<const BrickSource> source, const Scene& sce
   using Clock = std::chrono::steady_clock;
   Renderer renderer(std::move(source), options);
   ConvergeRun run;
-  run.cache_slots = renderer.backend_config().cache_slots;
+  run.cache_slots = inspect::backend_config(renderer).cache_slots;
   run.brick_bytes = renderer.hierarchy().layout().padded_voxels() *
                     voxel_size(renderer.hierarchy().volume().type);
   FrameReport report;
@@ -46,7 +47,7 @@ ConvergeRun converge(std::shared_ptr<const BrickSource> source, const Scene& sce
   run.ms_total = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   run.converged = report.converged;
   {
-    const PageTable& pt = renderer.page_table();
+    const PageTable& pt = inspect::page_table(renderer);
     run.page_blocks = pt.allocated_blocks();
     run.page_pool_blocks = pt.pool_block_count();
     run.page_table_bytes =
@@ -55,7 +56,7 @@ ConvergeRun converge(std::shared_ptr<const BrickSource> source, const Scene& sce
   }
   run.working_set_bricks = report.stats.working_set_bricks;
   run.working_set_bytes = report.stats.working_set_bytes;
-  const BrickLoaderStats loads = renderer.loader().stats();
+  const BrickLoaderStats loads = inspect::loader(renderer).stats();
   run.bricks_loaded = loads.loads;
   run.host_hits = loads.host_hits;
   if (run.converged && steady_frames > 0) {

@@ -18,6 +18,7 @@
 #include "resoct/base/file_io.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/overview_scene.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/cli_parse.hpp"
@@ -127,16 +128,16 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   j["bricks_touched"] = s.working_set_bricks;
   j["working_set_bytes"] = s.working_set_bytes;
   j["resident_bricks"] = s.resident_bricks;
-  j["cache_slots"] = r.cache().slot_count();
+  j["cache_slots"] = inspect::cache(r).slot_count();
   j["requests_total"] = t.requests;
   j["requests_dropped"] = t.dropped;
   j["cap_hits"] = t.cap_hits;
   j["bricks_uploaded"] = t.uploaded;
   j["bytes_uploaded"] = t.bytes_uploaded;
-  j["loads"] = r.loader().stats().loads;
-  j["host_cache_hits"] = r.loader().stats().host_hits;
+  j["loads"] = inspect::loader(r).stats().loads;
+  j["host_cache_hits"] = inspect::loader(r).stats().host_hits;
   // Time series (docs/renderer.md "Time series").
-  const BrickLoaderStats ls = r.loader().stats();
+  const BrickLoaderStats ls = inspect::loader(r).stats();
   j["timepoint"] = r.timepoint();
   j["timepoints"] = r.timepoints();
   j["prefetched"] = ls.prefetched;
@@ -306,7 +307,8 @@ int run(const Args& a) {
   const std::uint32_t tail = std::uint32_t(n);
 
 #ifdef RESOCT_RENDER_WITH_VULKAN
-  if (const auto* vb = dynamic_cast<const resoct::vk::VulkanBackend*>(&renderer.backend())) {
+  if (const auto* vb =
+          dynamic_cast<const resoct::vk::VulkanBackend*>(&inspect::backend(renderer))) {
     totals.validation_messages = vb->validation_messages();
     for (const std::string& m : vb->validation_log()) {
       std::fprintf(stderr, "resoct-render: validation: %s\n", m.c_str());

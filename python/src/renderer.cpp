@@ -13,6 +13,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #ifdef RESOCT_PYTHON_WITH_VULKAN
 #include "resoct/vulkan/vulkan_backend.hpp"
 #endif
@@ -156,7 +157,8 @@ void bind_renderer(py::module_& m) {
            "Renders until a frame converged or max_frames were rendered; returns the last "
            "Frame, its failures those of all frames.")
       .def("wait_for_loads", &Renderer::wait_for_loads, py::call_guard<py::gil_scoped_release>())
-      .def_property_readonly("backend", [](Renderer& r) { return std::string(r.backend().name()); })
+      .def_property_readonly("backend",
+                             [](Renderer& r) { return std::string(inspect::backend(r).name()); })
       .def_property_readonly("timepoint", &Renderer::timepoint)
       .def_property_readonly("timepoints", &Renderer::timepoints)
       .def_property_readonly("frame_index", &Renderer::frame_index);

@@ -7,6 +7,7 @@
 
 #include "backend_impl.hpp"
 #include "resoct/base/error.hpp"
+#include "resoct/kernel/page_entry.glsl.h"
 
 namespace resoct::vk {
 

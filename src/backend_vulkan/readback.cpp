@@ -6,6 +6,7 @@
 
 #include "backend_impl.hpp"
 #include "resoct/base/error.hpp"
+#include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
 namespace resoct::vk {

@@ -12,6 +12,7 @@
 
 #include "backend_impl.hpp"
 #include "resoct/base/error.hpp"
+#include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 

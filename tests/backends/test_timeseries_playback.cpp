@@ -15,6 +15,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/time_series_source.hpp"
 #ifdef RESOCT_TEST_VULKAN
@@ -101,7 +102,7 @@ TEST_P(TimeSeriesPlayback, EachConvergedTimepointEqualsAFreshRendererAtIt) {
     }
     previous = played.last.image;
   }
-  const BrickLoaderStats ls = player.loader().stats();
+  const BrickLoaderStats ls = inspect::loader(player).stats();
   EXPECT_EQ(ls.timepoint_switches, 4u);
   if (options_.prefetch.next_timepoint) {
     EXPECT_GT(ls.prefetched, 0u);
@@ -120,7 +121,7 @@ TEST_P(TimeSeriesPlayback, TheFrameThatSwitchesShowsNothingOfThePreviousTimepoin
   scene.timepoint = 4;
   const FrameReport first = player.render_frame(scene);
   EXPECT_TRUE(first.stats.timepoint_switched);
-  EXPECT_EQ(player.cache().resident_count(), 0u);
+  EXPECT_EQ(inspect::cache(player).resident_count(), 0u);
   Renderer fresh(series, options_);
   const FrameReport fresh_first = fresh.render_frame(scene);
   EXPECT_TRUE(same_bytes(first.image, fresh_first.image));
@@ -141,7 +142,7 @@ TEST_P(TimeSeriesPlayback, ASceneWithoutATimepointShowsTheOneTheSourceWasOpenedA
   const ConvergeReport own = r.render_until_converged(scene, 64);
   ASSERT_TRUE(own.converged);
   EXPECT_EQ(own.last.stats.timepoint, 2u);
-  EXPECT_EQ(r.loader().stats().timepoint_switches, 0u);
+  EXPECT_EQ(inspect::loader(r).stats().timepoint_switches, 0u);
   scene.timepoint = 2;
   Renderer from_0(make_moving_ball_series(5), options_);
   EXPECT_TRUE(same_bytes(own.last.image, from_0.render_until_converged(scene, 64).last.image));

@@ -12,6 +12,7 @@
 #include "support/expect_error.hpp"
 #include "resoct/scene/camera.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 
 namespace resoct::test {
 namespace {
@@ -289,7 +290,7 @@ TEST(CpuLens, HugeVolumePagesOnlyTheNeighbourhood) {
   const ConvergeReport rep = renderer.render_until_converged(s, 40);
   EXPECT_TRUE(rep.converged);
   EXPECT_EQ(rep.last.stats.backend.cap_hits, 0u);
-  const PageTable& pages = renderer.page_table();
+  const PageTable& pages = inspect::page_table(renderer);
   const BrickHierarchy& h = renderer.hierarchy();
   std::uint32_t resident = 0;
   for (std::uint32_t l = 0; l < h.level_count(); ++l) {

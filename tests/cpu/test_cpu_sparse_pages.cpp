@@ -16,6 +16,7 @@
 #include "resoct/kernel/request_key.glsl.h"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 #include "support/resident_scene.hpp"
@@ -66,7 +67,7 @@ TEST(CpuSparsePages, BlockMissesFirstThenBricksThenTheResidentImage) {
       make_procedural_source("procedural:sphere:128x128x128", BrickLayout{glm::uvec3(4), 1});
   const Scene scene = scene_for(40, {1.6, 1.3, 1.9});
   Renderer r(source, options(glm::uvec3(8)));
-  EXPECT_EQ(r.page_table().allocated_blocks(), 0u);
+  EXPECT_EQ(inspect::page_table(r).allocated_blocks(), 0u);
 
   const FrameReport f1 = r.render_frame(scene);
   EXPECT_FALSE(f1.converged);
@@ -91,7 +92,7 @@ TEST(CpuSparsePages, BlockMissesFirstThenBricksThenTheResidentImage) {
   ASSERT_TRUE(last.converged) << frames << " frames";
   EXPECT_EQ(last.stats.block_misses, 0u);
   EXPECT_EQ(last.stats.backend.cap_hits, 0u);
-  EXPECT_LE(r.page_table().allocated_blocks(), r.page_table().max_blocks());
+  EXPECT_LE(inspect::page_table(r).allocated_blocks(), inspect::page_table(r).max_blocks());
   expect_same_image(last.image, resident_image(*source, scene, glm::uvec3(8)));
 }
 
@@ -108,17 +109,17 @@ TEST(CpuSparsePages, SmallPoolIsReclaimedWhileTheViewMovesAndStillConverges) {
   ASSERT_EQ(PageTable::block_count(source->hierarchy(), 1), 589u);
   Renderer r(source, o);
   std::uint32_t full_pool_frames = 0;
-  std::vector<std::uint32_t> last_dir = r.page_table().directory();
+  std::vector<std::uint32_t> last_dir = inspect::page_table(r).directory();
   std::uint64_t freed = 0;  // directory entries that went from allocated back to 0
   for (int i = 0; i < 24; ++i) {
     const double a = 0.5 * i;
     const FrameReport f =
         r.render_frame(scene_for(16, {0.5 + 0.7 * std::cos(a), 0.5 + 0.7 * std::sin(a), 0.55}));
     ASSERT_EQ(f.stats.backend.cap_hits, 0u);
-    const auto& dir = r.page_table().directory();
+    const auto& dir = inspect::page_table(r).directory();
     for (std::size_t d = 0; d < dir.size(); ++d) freed += last_dir[d] != 0 && dir[d] == 0 ? 1 : 0;
     last_dir = dir;
-    full_pool_frames += r.page_table().allocated_blocks() == o.page_pool_blocks ? 1 : 0;
+    full_pool_frames += inspect::page_table(r).allocated_blocks() == o.page_pool_blocks ? 1 : 0;
   }
   EXPECT_GT(full_pool_frames, 0u);
   EXPECT_GT(freed, 0u) << "the pool was never reclaimed";
@@ -133,7 +134,7 @@ TEST(CpuSparsePages, SmallPoolIsReclaimedWhileTheViewMovesAndStillConverges) {
   Renderer ref(source, big);
   const ConvergeReport ref_rep = ref.render_until_converged(still, 64);
   ASSERT_TRUE(ref_rep.converged);
-  EXPECT_EQ(ref.page_table().max_blocks(), 589u);
+  EXPECT_EQ(inspect::page_table(ref).max_blocks(), 589u);
   expect_same_image(rep.last.image, ref_rep.last.image);
 }
 
@@ -162,10 +163,10 @@ TEST(CpuSparsePages, Volume65536CubedConvergesAtADistantViewWithABoundedPool) {
   ASSERT_TRUE(rep.converged) << rep.frames << " frames";
   EXPECT_EQ(rep.last.stats.backend.cap_hits, 0u);
   EXPECT_GT(rep.last.stats.working_set_bricks, 0u);
-  EXPECT_LE(r.page_table().allocated_blocks(), 2048u);
+  EXPECT_LE(inspect::page_table(r).allocated_blocks(), 2048u);
   // Host memory: the directory (about 2.4 M words) and the blocks in use, nothing per brick.
-  EXPECT_LT(r.page_table().directory().size(), 3'000'000u);
-  EXPECT_LE(r.page_table().pool().size(), (2048u + 1u) * 4096u);
+  EXPECT_LT(inspect::page_table(r).directory().size(), 3'000'000u);
+  EXPECT_LE(inspect::page_table(r).pool().size(), (2048u + 1u) * 4096u);
   std::size_t shown = 0;
   for (const glm::vec4& px : rep.last.image.pixels()) shown += px.a > 0.01f ? 1u : 0u;
   EXPECT_GT(shown, 0u);
@@ -186,11 +187,11 @@ TEST(CpuSparsePages, PoolSizeIsCheckedAtConstruction) {
   // A pool covering every block needs no headroom; the default is clamped to the blocks.
   o.device_cache_bytes = 1000 * slot_bytes;
   o.page_pool_blocks = 589;
-  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 589u);
+  EXPECT_EQ(inspect::page_table(Renderer(source, o)).max_blocks(), 589u);
   o.page_pool_blocks = 0;
-  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 589u);
+  EXPECT_EQ(inspect::page_table(Renderer(source, o)).max_blocks(), 589u);
   o.device_cache_bytes = 100 * slot_bytes;
-  EXPECT_EQ(Renderer(source, o).page_table().max_blocks(), 164u);  // 100 + max(50, 64)
+  EXPECT_EQ(inspect::page_table(Renderer(source, o)).max_blocks(), 164u);  // 100 + max(50, 64)
 }
 
 }  // namespace

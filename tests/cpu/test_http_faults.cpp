@@ -21,6 +21,7 @@
 #include "resoct/io/open_source.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/http_test_server.hpp"
 #include "support/test_views.hpp"
@@ -120,7 +121,7 @@ TEST(HttpFaults, RenderingSurvivesInjectedFaultsAndConvergesOnceTheServerHeals) 
     EXPECT_TRUE(keys.insert(f.key).second) << "reported twice: " << f.message;
     EXPECT_NE(f.message.find("/chaos/tubes.rbs"), std::string::npos) << f.message;
   }
-  const BrickLoaderStats ls = remote.loader().stats();
+  const BrickLoaderStats ls = inspect::loader(remote).stats();
   EXPECT_EQ(ls.failures, reported.size());
   EXPECT_GT(reported.size(), 0u) << "the faults must have failed some bricks";
   EXPECT_GT(ls.retries, 0u);

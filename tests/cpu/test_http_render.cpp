@@ -8,6 +8,7 @@
 #include "resoct/io/open_source.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/http_test_server.hpp"
 
@@ -47,5 +48,5 @@ TEST(HttpRender, ImagesEqualTheLocalStoreFrameByFrame) {
   }
   EXPECT_TRUE(converged);
   EXPECT_GT(frames, 1);
-  EXPECT_GT(remote.loader().stats().loads, 0u);
+  EXPECT_GT(inspect::loader(remote).stats().loads, 0u);
 }

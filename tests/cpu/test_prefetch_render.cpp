@@ -14,6 +14,7 @@
 #include "resoct/engine/prefetch.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/expect_error.hpp"
 
@@ -59,7 +60,7 @@ TEST(PrefetchRender, EnumerationContainsEveryBrickTheTraversalRequests) {
       for (std::uint32_t z = 0; z < n.z; ++z) {
         for (std::uint32_t y = 0; y < n.y; ++y) {
           for (std::uint32_t x = 0; x < n.x; ++x) {
-            const std::uint32_t e = r.page_table().entry(PageAddress{0, l, {x, y, z}});
+            const std::uint32_t e = inspect::page_table(r).entry(PageAddress{0, l, {x, y, z}});
             if (kernel::resoct_page_state(e) == kernel::RESOCT_PAGE_STATE_UNMAPPED) continue;
             ++loaded;
             EXPECT_TRUE(set.count(BrickKey(l, 0, {x, y, z})))
@@ -97,9 +98,9 @@ TEST(PrefetchRender, ChangesNoImageAndServesLaterRequests) {
     ASSERT_EQ(ra.image.pixels(), rb.image.pixels()) << "frame " << f;
   }
   EXPECT_GT(queued, 0u);
-  EXPECT_GT(b.loader().stats().prefetched, 0u);
-  EXPECT_GT(b.loader().stats().prefetch_hits, 0u);
-  EXPECT_EQ(a.loader().stats().prefetched, 0u);
+  EXPECT_GT(inspect::loader(b).stats().prefetched, 0u);
+  EXPECT_GT(inspect::loader(b).stats().prefetch_hits, 0u);
+  EXPECT_EQ(inspect::loader(a).stats().prefetched, 0u);
 }
 
 TEST(PrefetchRender, OptionsAreValidated) {
@@ -117,7 +118,7 @@ TEST(PrefetchRender, OptionsAreValidated) {
   o.host_eviction = parse_eviction("octreemizer", "host_eviction");
   std::shared_ptr<const BrickSource> src = make_procedural_source("procedural:sphere:32x32x32");
   Renderer r(src, o);
-  EXPECT_EQ(r.loader().stats().loads, 0u);
+  EXPECT_EQ(inspect::loader(r).stats().loads, 0u);
   const ConvergeReport rep = r.render_until_converged(tubes_scene(16), 32);
   EXPECT_TRUE(rep.converged);
 }

@@ -11,6 +11,7 @@
 #include "resoct/scene/overview_scene.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/expect_error.hpp"
 #include "support/sanitized.hpp"
 
@@ -71,7 +72,7 @@ TEST(RendererApi, BackendObjectRendersWhatTheRegisteredBackendRenders) {
   RendererOptions named = sync_viewer();
   named.backend = "no-such-backend";
   Renderer by_object(src, cpu::make_backend(2), named);
-  EXPECT_EQ(by_object.backend().name(), "cpu");
+  EXPECT_EQ(inspect::backend(by_object).name(), "cpu");
   const ConvergeReport a = by_object.render_until_converged(scene, 64);
 
   cpu::register_backend();

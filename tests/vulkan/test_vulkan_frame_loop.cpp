@@ -19,6 +19,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
@@ -36,17 +37,18 @@ std::vector<T> words_of(const std::vector<std::byte>& bytes) {
 std::size_t expect_device_matches_host(const Renderer& r, const vk::VulkanBackend& gpu,
                                        const std::string& what) {
   // The device pool: the host's used prefix, UNMAPPED beyond it.
-  std::vector<std::uint32_t> pool = r.page_table().pool();
-  pool.resize(std::size_t(r.page_table().pool_block_count()) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
-              0u);
+  std::vector<std::uint32_t> pool = inspect::page_table(r).pool();
+  pool.resize(
+      std::size_t(inspect::page_table(r).pool_block_count()) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
+      0u);
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::pages)), pool) << what;
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory)),
-            r.page_table().directory())
+            inspect::page_table(r).directory())
       << what;
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::directory_offsets)),
-            r.page_table().directory_offsets())
+            inspect::page_table(r).directory_offsets())
       << what;
-  const auto& words = r.octree().words();
+  const auto& words = inspect::octree(r).words();
   EXPECT_EQ(words_of<std::uint32_t>(gpu.debug_read(vk::DeviceArray::nodes)),
             std::vector<std::uint32_t>(words.begin(), words.end()))
       << what;
@@ -56,8 +58,8 @@ std::size_t expect_device_matches_host(const Renderer& r, const vk::VulkanBacken
       std::size_t(h.layout().padded_voxels()) * voxel_size(h.volume().type);
   std::vector<std::byte> expected(brick_bytes);
   std::size_t occupied = 0;
-  for (std::uint32_t s = 0; s < r.cache().slot_count(); ++s) {
-    const auto key = r.cache().key_of(s);
+  for (std::uint32_t s = 0; s < inspect::cache(r).slot_count(); ++s) {
+    const auto key = inspect::cache(r).key_of(s);
     if (!key) continue;
     ++occupied;
     r.source().read_brick(*key, expected);
@@ -92,7 +94,7 @@ TEST(VulkanDeltaUploads, ManyFramesWithEvictionAndRemapsMatchTheHostState) {
   o.upload_budget = UploadBudget{6, ~0ull};
   o.ttl = 1;
   Renderer r(source, o);
-  auto* gpu = dynamic_cast<vk::VulkanBackend*>(&r.backend());
+  auto* gpu = dynamic_cast<vk::VulkanBackend*>(&inspect::backend(r));
   ASSERT_NE(gpu, nullptr);
 
   Scene base = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/cells.json");
@@ -122,7 +124,7 @@ TEST(VulkanDeltaUploads, ManyFramesWithEvictionAndRemapsMatchTheHostState) {
     evictions += rep.stats.evictions;
     uploads += rep.stats.bricks_uploaded;
     for (std::uint32_t slot = 0; slot < 3; ++slot) {
-      const auto c = r.channel_map().channel(slot);
+      const auto c = inspect::channel_map(r).channel(slot);
       if (slot_channel[slot] && c != slot_channel[slot]) ++remaps;
       slot_channel[slot] = c;
     }
@@ -169,19 +171,19 @@ TEST(VulkanDeltaUploads, BlockAllocationAndReclaimMatchTheHostStateAndConverge) 
   o.page_pool_blocks = 17;
   ASSERT_EQ(PageTable::block_count(source->hierarchy(), 1), 589u);
   Renderer r(source, o);
-  auto* gpu = dynamic_cast<vk::VulkanBackend*>(&r.backend());
+  auto* gpu = dynamic_cast<vk::VulkanBackend*>(&inspect::backend(r));
   ASSERT_NE(gpu, nullptr);
   Scene s = load_scene(std::string(RESOCT_SOURCE_DIR) + "/examples/scenes/sphere.json");
   s.viewport = Viewport{16, 16};
   std::uint64_t misses = 0, freed = 0;
-  std::vector<std::uint32_t> last_dir = r.page_table().directory();
+  std::vector<std::uint32_t> last_dir = inspect::page_table(r).directory();
   for (int frame = 0; frame < 16; ++frame) {
     const double a = 0.7 * frame;
     // Close to the volume: the finest levels of the blocks near the eye are needed.
     s.camera.eye = {0.5 + 0.7 * std::cos(a), 0.5 + 0.7 * std::sin(a), 0.55};
     const FrameReport rep = r.render_frame(s);
     misses += rep.stats.block_misses;
-    const auto& dir = r.page_table().directory();
+    const auto& dir = inspect::page_table(r).directory();
     for (std::size_t d = 0; d < dir.size(); ++d) freed += last_dir[d] != 0 && dir[d] == 0 ? 1 : 0;
     last_dir = dir;
     expect_device_matches_host(r, *gpu, "frame " + std::to_string(frame));

@@ -13,6 +13,7 @@
 #include "resoct/scene/overview_scene.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/scene.hpp"
 #include "support/vulkan_required.hpp"
 
@@ -238,7 +239,7 @@ TEST_F(VulkanInterop, RendererTakesAnApplicationDeviceBackend) {
   o.loader_threads = 0;
   Renderer on_gpu(src, vk::make_backend(app_.instance, app_.physical, app_.device, app_.family), o);
   Renderer on_cpu(src, cpu::make_backend(1), o);
-  EXPECT_EQ(on_gpu.backend().name(), "vulkan");
+  EXPECT_EQ(inspect::backend(on_gpu).name(), "vulkan");
   const ConvergeReport a = on_cpu.render_until_converged(scene, 64);
   const ConvergeReport b = on_gpu.render_until_converged(scene, 64);
   ASSERT_TRUE(a.converged);

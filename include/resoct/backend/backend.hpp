@@ -21,9 +21,7 @@
 
 #include "resoct/backend/image.hpp"
 #include "resoct/kernel/frame.glsl.h"
-#include "resoct/engine/page_table.hpp"
-#include "resoct/engine/request_set.hpp"
-#include "resoct/engine/residency_octree.hpp"
+#include "resoct/engine/device_records.hpp"
 #include "resoct/scene/transfer_function.hpp"
 #include "resoct/volume/voxel_type.hpp"
 

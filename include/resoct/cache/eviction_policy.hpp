@@ -11,20 +11,11 @@
 
 #include <glm/vec3.hpp>
 
+#include "resoct/cache/eviction.hpp"
 #include "resoct/volume/brick_key.hpp"
 #include "resoct/volume/hierarchy.hpp"
 
 namespace resoct {
-
-/// The eviction policies a renderer's caches can use (RendererOptions::eviction, host_eviction).
-enum class Eviction : std::uint8_t {
-  lru,          ///< LruPolicy
-  octreemizer,  ///< OctreemizerPolicy, distances from the current camera
-};
-/// "lru" / "octreemizer".
-const char* to_string(Eviction e) noexcept;
-/// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
-Eviction parse_eviction(std::string_view s, std::string_view parameter = "eviction");
 
 /// The cache's record of one slot, 32 bytes so that a touch reads one cache line.
 struct alignas(32) CacheSlot {

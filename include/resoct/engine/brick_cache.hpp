@@ -13,6 +13,7 @@
 
 #include "resoct/volume/brick_key.hpp"
 #include "resoct/cache/eviction_policy.hpp"
+#include "resoct/engine/upload_budget.hpp"
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/volume/voxel_type.hpp"
 
@@ -111,12 +112,6 @@ class BrickCache {
   std::vector<std::uint32_t> free_;  // stack of free slots
   detail::KeySlotIndex index_;
   BrickCacheStats stats_;
-};
-
-/// Per-frame upload limits (paper 001's reload limit), in bricks and in bytes.
-struct UploadBudget {
-  std::uint64_t max_bricks = std::numeric_limits<std::uint64_t>::max();
-  std::uint64_t max_bytes = std::numeric_limits<std::uint64_t>::max();
 };
 
 /// One brick waiting for upload and the bytes it costs (0 for page-only updates such as EMPTY).

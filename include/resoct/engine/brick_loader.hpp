@@ -22,6 +22,7 @@
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/cache/eviction_policy.hpp"
 #include "resoct/cache/host_brick_cache.hpp"
+#include "resoct/engine/load_failure.hpp"
 #include "resoct/volume/timed_brick_key.hpp"
 #include "resoct/sources/timepoint_sources.hpp"
 
@@ -45,12 +46,6 @@ struct LoadedBrick {
   std::uint64_t since = 0;
   std::uint32_t rank = 0;
   LoadRequest request() const { return {brick->key, hits, since, rank}; }
-};
-
-/// A brick that could not be loaded; reported once.
-struct LoadFailure {
-  BrickKey key;
-  std::string message;  ///< "<source name>: brick level L channel C (x, y, z): <reason>"
 };
 
 struct BrickLoaderStats {

@@ -13,18 +13,12 @@
 
 #include <glm/vec3.hpp>
 
+#include "resoct/engine/device_records.hpp"
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/volume/voxel_type.hpp"
 
 namespace resoct {
-
-/// One changed word: its index (in pool() or directory()) and its value at take_deltas() time.
-struct PageDelta {
-  std::uint32_t index = 0;
-  std::uint32_t value = 0;
-  friend bool operator==(const PageDelta&, const PageDelta&) = default;
-};
 
 /// The changes of both arrays since the last take_deltas(), each sorted by index.
 struct PageTableDeltas {

@@ -12,18 +12,11 @@
 #include <vector>
 
 #include "resoct/volume/hierarchy.hpp"
+#include "resoct/engine/device_records.hpp"
 #include "resoct/engine/page_table.hpp"
+#include "resoct/engine/request_strategy.hpp"
 
 namespace resoct {
-
-/// One drained request: its key, how many inserts asked for it (screen coverage: rays), and the
-/// level used for ordering (larger = coarser).
-struct Request {
-  std::uint32_t key = 0;
-  std::uint32_t hits = 0;
-  std::uint32_t level = 0;
-  friend bool operator==(const Request&, const Request&) = default;
-};
 
 /// What drain() hands out for one frame.
 struct RequestBatch {
@@ -80,16 +73,6 @@ class RequestSet {
   std::atomic<std::uint32_t> filled_{0};
   std::atomic<std::uint64_t> dropped_{0};
 };
-
-/// How a ray that misses its target brick asks for data (paper 002 §5.3.2).
-enum class RequestStrategy : std::uint8_t {
-  greedy,  ///< the target and every coarser level on the way up
-  global,  ///< only the target
-};
-/// "greedy" / "global".
-const char* to_string(RequestStrategy s) noexcept;
-/// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
-RequestStrategy parse_request_strategy(std::string_view s, std::string_view parameter = "strategy");
 
 /// The brick at coarser level `level` that contains `brick` of level `from` (level >= from).
 /// Bricks of every level have the same core size and levels differ by powers of two per axis, so

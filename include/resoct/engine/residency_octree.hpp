@@ -15,6 +15,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "resoct/engine/device_records.hpp"
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/engine/octree_layout.hpp"
@@ -26,13 +27,6 @@ namespace resoct {
 /// page table provides it; it must already reflect an eviction when brick_evicted() is called.
 using ResidencyQuery =
     std::function<bool(std::uint32_t slot, std::uint32_t level, glm::uvec3 brick)>;
-
-/// One changed device word: storage index and its new value.
-struct OctreeWordDelta {
-  std::uint32_t index = 0;
-  std::uint32_t value = 0;
-  friend bool operator==(const OctreeWordDelta&, const OctreeWordDelta&) = default;
-};
 
 /// The changes since the last take_deltas(). When `full` is set so many words changed (e.g. after
 /// remap_slot()) that the backend should re-upload all of words(); `words` is then empty.

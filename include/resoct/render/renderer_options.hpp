@@ -4,19 +4,17 @@
 /// expert tuning knobs of the frame loop (TuningOptions), and, for the command-line tools, the
 /// backend chosen by name (RendererOptions). docs/api.md has the guide.
 
-#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
 #include <string_view>
-#include <thread>
 
 #include <glm/vec3.hpp>
 
 #include "resoct/backend/backend.hpp"
-#include "resoct/engine/brick_cache.hpp"
-#include "resoct/cache/eviction_policy.hpp"
-#include "resoct/engine/request_set.hpp"
+#include "resoct/cache/eviction.hpp"
+#include "resoct/engine/request_strategy.hpp"
+#include "resoct/engine/upload_budget.hpp"
 
 namespace resoct {
 
@@ -54,12 +52,16 @@ const char* to_string(FrameOutput o) noexcept;
 /// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
 FrameOutput parse_frame_output(std::string_view s, std::string_view parameter = "output");
 
+/// max(1, std::thread::hardware_concurrency()): one loader thread per core, the default of
+/// ViewerOptions::loader_threads.
+std::uint32_t default_loader_threads() noexcept;
+
 /// What a viewer chooses: memory, loading threads, the rendering method and the output form.
 struct ViewerOptions {
   std::uint64_t device_cache_bytes = std::uint64_t(512) << 20;  ///< bricks on the device, > 0
   std::uint64_t host_cache_bytes = std::uint64_t(1) << 30;      ///< decoded bricks in host memory
   /// Loader threads; 0 loads synchronously inside render_frame (deterministic), at most 1024.
-  std::uint32_t loader_threads = std::max(1u, std::thread::hardware_concurrency());
+  std::uint32_t loader_threads = default_loader_threads();
   RenderMode mode = RenderMode::residency;
   RequestStrategy strategy = RequestStrategy::greedy;
   Eviction eviction = Eviction::lru;  ///< device cache

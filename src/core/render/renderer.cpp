@@ -3,11 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <mutex>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
+#include <glm/vec3.hpp>
+
 #include "resoct/base/error.hpp"
+#include "resoct/engine/prefetch.hpp"
+#include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
@@ -16,6 +23,12 @@ namespace resoct {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// A camera position read by loader threads (host cache Octreemizer distances).
+struct SharedEye {
+  std::mutex mutex;
+  glm::dvec3 eye{0.0};
+};
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -93,18 +106,81 @@ bool page_unmapped(std::uint32_t entry) {
   return kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED;
 }
 
-}  // namespace
-
-std::unique_ptr<Backend> Renderer::named_backend(const RendererOptions& options) {
+std::unique_ptr<Backend> named_backend(const RendererOptions& options) {
   options.validate();  // before creating a device for options that would be refused anyway
   return create_backend(options.backend, options.backend_options);
 }
+
+}  // namespace
+
+// The Renderer's state and the frame loop's steps; the Renderer forwards to it.
+struct Renderer::Impl {
+  Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
+       RendererOptions options);
+
+  std::uint32_t timepoints() const noexcept { return source_->timepoints(); }
+  void render_frame(const Scene& scene, FrameReport& report);
+
+  const FrameTables& frame_tables(const Scene& scene);
+  void take_pixels(FrameReport& report);
+  void assign_channels(const Scene& scene);
+  void switch_timepoint(std::uint32_t t);
+  /// Bricks of the next timepoint the scene's view may need, for PrefetchOptions::next_timepoint.
+  void prefetch_next_timepoint(const Scene& scene, std::size_t max,
+                               std::vector<TimedBrickKey>& keys);
+  void apply_loaded(FrameStats& stats);
+  bool apply_one(const LoadedBrick& b, FrameStats& stats);
+  void evict(BrickKey key);
+  void send_update(FrameStats& stats);
+  void answer_nodes(FrameStats& stats);
+  bool handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats);
+  void prefetch(const Scene& scene, FrameStats& stats);
+  void report_failures(FrameReport& report);
+
+  std::shared_ptr<const BrickSource> source_;
+  // The shown timepoint and its source (region metadata is per timepoint).
+  std::uint32_t timepoint_ = 0;
+  std::shared_ptr<const BrickSource> timepoint_source_;
+  RendererOptions options_;
+  BrickHierarchy hierarchy_;
+  OctreeLayout layout_;
+  PageTable pages_;
+  ChannelMap channels_;
+  std::unique_ptr<BrickCache> cache_;
+  std::unique_ptr<ResidencyOctree> octree_;
+  std::unique_ptr<BrickLoader> loader_;
+  std::unique_ptr<Backend> backend_;
+  BackendConfig config_;
+  std::function<void(const LoadFailure&)> on_failure_;
+
+  std::vector<std::uint32_t> channel_rank_;  // per dataset channel: load rank in this scene
+  glm::dvec3 camera_{0.0};                   // eye in physical units (Octreemizer distances)
+  // The same for the host cache's policy, which runs on loader threads.
+  std::shared_ptr<SharedEye> host_camera_ = std::make_shared<SharedEye>();
+  CameraPredictor predictor_;
+  std::uint64_t frame_ = 0;
+  bool send_full_ = true;                      // next update carries full arrays
+  std::vector<LoadedBrick> staged_;            // loaded, waiting for budget or a free slot
+  std::vector<std::uint32_t> pending_nodes_;   // node requests to answer next frame
+  std::vector<std::uint32_t> pending_blocks_;  // page-table blocks to allocate next frame
+  // Requested bricks -> frame of their first request in an unbroken run of frames (ageing).
+  std::unordered_map<BrickKey, std::uint64_t> waiting_since_;
+  std::vector<std::byte> scratch_;  // keeps the voxels of this frame's uploads alive
+  std::vector<std::shared_ptr<const HostBrick>> upload_data_;
+  std::vector<BrickUpload> uploads_;
+  FrameTables tables_;
+  FrameResult result_;
+};
 
 Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions options)
     : Renderer(std::move(source), named_backend(options), options) {}
 
 Renderer::Renderer(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
                    RendererOptions options)
+    : impl_(std::make_unique<Impl>(std::move(source), std::move(backend), std::move(options))) {}
+
+Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
+                     RendererOptions options)
     : source_(std::move(source)),
       options_(validated(std::move(options), backend.get())),
       hierarchy_(checked_source(source_).hierarchy()),
@@ -152,7 +228,32 @@ Renderer::Renderer(std::shared_ptr<const BrickSource> source, std::unique_ptr<Ba
 
 Renderer::~Renderer() = default;
 
-void Renderer::assign_channels(const Scene& scene) {
+std::uint32_t Renderer::timepoint() const noexcept {
+  return impl_->timepoint_;
+}
+std::uint32_t Renderer::timepoints() const noexcept {
+  return impl_->timepoints();
+}
+void Renderer::wait_for_loads() {
+  impl_->loader_->wait_idle();
+}
+void Renderer::set_failure_callback(std::function<void(const LoadFailure&)> fn) {
+  impl_->on_failure_ = std::move(fn);
+}
+const RendererOptions& Renderer::options() const noexcept {
+  return impl_->options_;
+}
+const BrickSource& Renderer::source() const noexcept {
+  return *impl_->source_;
+}
+const BrickHierarchy& Renderer::hierarchy() const noexcept {
+  return impl_->hierarchy_;
+}
+std::uint64_t Renderer::frame_index() const noexcept {
+  return impl_->frame_;
+}
+
+void Renderer::Impl::assign_channels(const Scene& scene) {
   // Load priority among channels: ascending importance, ties in scene order.
   std::vector<std::size_t> order(scene.channels.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -191,7 +292,7 @@ void Renderer::assign_channels(const Scene& scene) {
   }
 }
 
-void Renderer::switch_timepoint(std::uint32_t t) {
+void Renderer::Impl::switch_timepoint(std::uint32_t t) {
   // Opened first: if opening fails nothing has changed yet.
   std::shared_ptr<const BrickSource> next = loader_->timepoint_sources().at(t);
   loader_->set_timepoint(t);
@@ -218,14 +319,14 @@ void Renderer::switch_timepoint(std::uint32_t t) {
   pending_nodes_.clear();
 }
 
-void Renderer::evict(BrickKey key) {
+void Renderer::Impl::evict(BrickKey key) {
   const auto addr = channels_.address_of(key);
   if (!addr) return;  // released with its slot already
   pages_.set_unmapped(*addr);
   octree_->brick_evicted(addr->slot, addr->level, addr->brick);
 }
 
-bool Renderer::apply_one(const LoadedBrick& b, FrameStats& stats) {
+bool Renderer::Impl::apply_one(const LoadedBrick& b, FrameStats& stats) {
   const HostBrick& hb = *b.brick;
   const PageAddress addr = *channels_.address_of(hb.key);
   if (hb.meta.constant) {
@@ -262,7 +363,7 @@ bool Renderer::apply_one(const LoadedBrick& b, FrameStats& stats) {
   return true;
 }
 
-void Renderer::apply_loaded(FrameStats& stats) {
+void Renderer::Impl::apply_loaded(FrameStats& stats) {
   std::vector<LoadedBrick> fresh = loader_->take_ready();
   std::unordered_set<BrickKey> seen;
   std::vector<LoadedBrick> all;
@@ -310,7 +411,7 @@ void Renderer::apply_loaded(FrameStats& stats) {
   stats.uploads_deferred = staged_.size();
 }
 
-void Renderer::answer_nodes(FrameStats& stats) {
+void Renderer::Impl::answer_nodes(FrameStats& stats) {
   std::uint64_t answered = 0;
   for (std::uint32_t node : pending_nodes_) {
     if (node >= layout_.node_count()) continue;  // device data is not trusted
@@ -329,7 +430,7 @@ void Renderer::answer_nodes(FrameStats& stats) {
   stats.nodes_answered = answered;
 }
 
-void Renderer::send_update(FrameStats& stats) {
+void Renderer::Impl::send_update(FrameStats& stats) {
   FrameUpdate u;
   u.bricks = uploads_;
   const PageTableDeltas page_deltas = pages_.take_deltas();
@@ -363,7 +464,8 @@ void Renderer::send_update(FrameStats& stats) {
   upload_data_.clear();
 }
 
-bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats) {
+bool Renderer::Impl::handle_requests(const FrameResult& result, std::uint64_t epoch,
+                                     FrameStats& stats) {
   const ResolvedRequests resolved = channels_.resolve(result.brick_requests, epoch, pages_);
   stats.brick_requests = result.brick_requests.size();
   stats.stale_requests = resolved.stale;
@@ -415,8 +517,8 @@ bool Renderer::handle_requests(const FrameResult& result, std::uint64_t epoch, F
   return outstanding || !pending_nodes_.empty() || result.stats.requests_dropped != 0;
 }
 
-void Renderer::prefetch_next_timepoint(const Scene& scene, std::size_t max,
-                                       std::vector<TimedBrickKey>& keys) {
+void Renderer::Impl::prefetch_next_timepoint(const Scene& scene, std::size_t max,
+                                             std::vector<TimedBrickKey>& keys) {
   const std::uint32_t next = (timepoint_ + 1) % timepoints();
   if (next == timepoint_) return;
   // Only what would still have to be read. The device holds nothing of another timepoint, so
@@ -431,7 +533,7 @@ void Renderer::prefetch_next_timepoint(const Scene& scene, std::size_t max,
   }
 }
 
-void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
+void Renderer::Impl::prefetch(const Scene& scene, FrameStats& stats) {
   predictor_.observe(scene.camera);
   const PrefetchOptions& po = options_.prefetch;
   if (po.lookahead_frames == 0 && !po.next_timepoint) return;
@@ -472,7 +574,7 @@ void Renderer::prefetch(const Scene& scene, FrameStats& stats) {
   stats.prefetch_queued = timed.size();
 }
 
-void Renderer::report_failures(FrameReport& report) {
+void Renderer::Impl::report_failures(FrameReport& report) {
   report.failures = loader_->take_failures();
   report.stats.new_failures = report.failures.size();
   if (on_failure_) {
@@ -480,7 +582,7 @@ void Renderer::report_failures(FrameReport& report) {
   }
 }
 
-const FrameTables& Renderer::frame_tables(const Scene& scene) {
+const FrameTables& Renderer::Impl::frame_tables(const Scene& scene) {
   FrameOptions fo;
   fo.mode = options_.mode;
   fo.frame_index = std::uint32_t(frame_);
@@ -500,7 +602,7 @@ FrameReport Renderer::render_frame(const Scene& scene) {
   return report;
 }
 
-void Renderer::take_pixels(FrameReport& report) {
+void Renderer::Impl::take_pixels(FrameReport& report) {
   const Image& rendered = result_.image;
   report.device_image = result_.device_image;
   if (result_.device_image.handle != 0) {
@@ -529,6 +631,10 @@ void Renderer::take_pixels(FrameReport& report) {
 }
 
 void Renderer::render_frame(const Scene& scene, FrameReport& report) {
+  impl_->render_frame(scene, report);
+}
+
+void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report) {
   const auto t_frame = Clock::now();
   scene.validate(hierarchy_.volume(), timepoints(), "scene");
   if (scene.channels.size() > channels_.slot_count()) {
@@ -607,10 +713,45 @@ ConvergeReport Renderer::render_until_converged(const Scene& scene, std::uint32_
     if (out.converged || out.frames >= max_frames) break;
     // With loader threads, waiting for the requested bricks makes every frame count instead of
     // re-rendering the same state while the loads run.
-    loader_->wait_idle();
+    impl_->loader_->wait_idle();
   }
   out.last.failures = std::move(failures);
   return out;
 }
+
+namespace inspect {
+
+// The one friend of Renderer: the functions below reach its Impl through it.
+struct Access {
+  static const Renderer::Impl& impl(const Renderer& r) noexcept { return *r.impl_; }
+  static Renderer::Impl& impl(Renderer& r) noexcept { return *r.impl_; }
+};
+
+const OctreeLayout& layout(const Renderer& r) noexcept {
+  return Access::impl(r).layout_;
+}
+const PageTable& page_table(const Renderer& r) noexcept {
+  return Access::impl(r).pages_;
+}
+const BrickCache& cache(const Renderer& r) noexcept {
+  return *Access::impl(r).cache_;
+}
+const ResidencyOctree& octree(const Renderer& r) noexcept {
+  return *Access::impl(r).octree_;
+}
+const ChannelMap& channel_map(const Renderer& r) noexcept {
+  return Access::impl(r).channels_;
+}
+const BrickLoader& loader(const Renderer& r) noexcept {
+  return *Access::impl(r).loader_;
+}
+Backend& backend(Renderer& r) noexcept {
+  return *Access::impl(r).backend_;
+}
+const BackendConfig& backend_config(const Renderer& r) noexcept {
+  return Access::impl(r).config_;
+}
+
+}  // namespace inspect
 
 }  // namespace resoct

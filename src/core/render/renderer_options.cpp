@@ -1,5 +1,8 @@
 #include "resoct/render/renderer_options.hpp"
 
+#include <algorithm>
+#include <thread>
+
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/frame.glsl.h"
 
@@ -15,6 +18,10 @@ void check_choice(E value, std::string_view field) {
   }
 }
 }  // namespace
+
+std::uint32_t default_loader_threads() noexcept {
+  return std::max(1u, std::thread::hardware_concurrency());
+}
 
 void ViewerOptions::validate() const {
   if (device_cache_bytes == 0) throw invalid_parameter("device_cache_bytes", "must be > 0");

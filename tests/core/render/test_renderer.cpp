@@ -8,7 +8,7 @@ namespace resoct::test {
 namespace {
 
 std::uint64_t slot_bytes(const Renderer& r) {
-  return r.cache().slot_bytes();
+  return inspect::cache(r).slot_bytes();
 }
 
 TEST(Renderer, UploadsStayWithinTheBrickBudgetAndStateMatchesTheSource) {
@@ -34,7 +34,7 @@ TEST(Renderer, UploadsStayWithinTheBrickBudgetAndStateMatchesTheSource) {
   // Every level-0 brick of the scene is available, non-constant ones as cache slots.
   std::uint64_t varying = 0;
   for (const PageAddress& a : level0_bricks(rig.renderer->hierarchy(), 0)) {
-    const std::uint32_t e = rig.renderer->page_table().entry(a);
+    const std::uint32_t e = inspect::page_table(*rig.renderer).entry(a);
     EXPECT_NE(kernel::resoct_page_state(e), kernel::RESOCT_PAGE_STATE_UNMAPPED);
     if (!src->brick_meta(BrickKey(0, 0, a.brick)).constant) ++varying;
   }
@@ -55,7 +55,7 @@ TEST(Renderer, ConstantBricksMapWithoutCacheSlots) {
   Rig rig(src, test_options(256, 256));
   const ConvergeReport rep = rig.renderer->render_until_converged(test_scene(1), 20);
   ASSERT_TRUE(rep.converged);
-  const auto& pt = rig.renderer->page_table();
+  const auto& pt = inspect::page_table(*rig.renderer);
   for (std::uint32_t y = 0; y < 4; ++y) {
     for (std::uint32_t z = 0; z < 4; ++z) {
       const std::uint32_t e0 = pt.entry(PageAddress{0, 0, {0, y, z}});
@@ -104,7 +104,7 @@ TEST(Renderer, NodeRequestsAreAnsweredFromRegionMetadata) {
   register_test_backend();
   Renderer r(src, test_options(64, 16));
   RecordingBackend* b = last_recording_backend();
-  const OctreeLayout& layout = r.layout();
+  const OctreeLayout& layout = inspect::layout(r);
   const std::uint32_t leaf_depth = layout.leaf_depth();
   const std::uint64_t first_leaf = layout.depth(leaf_depth).first_node;
   b->set_script([&](const FrameTables&, FrameResult& res, RecordingBackend&) {
@@ -125,9 +125,10 @@ TEST(Renderer, NodeRequestsAreAnsweredFromRegionMetadata) {
   for (std::uint32_t i = 0; i < 4; ++i) {
     const std::uint64_t node = first_leaf + i;
     const RegionMeta m = src->region_meta(2, layout.sampling_support(node));
-    EXPECT_EQ(r.octree().word(node, 0, kernel::RESOCT_NODE_MINMAX),
+    EXPECT_EQ(inspect::octree(r).word(node, 0, kernel::RESOCT_NODE_MINMAX),
               octree_pack_range(m.min, m.max, range));
-    EXPECT_EQ(r.octree().word(node, 0, kernel::RESOCT_NODE_FLAGS) & kernel::RESOCT_NODE_STATE_MASK,
+    EXPECT_EQ(inspect::octree(r).word(node, 0, kernel::RESOCT_NODE_FLAGS) &
+                  kernel::RESOCT_NODE_STATE_MASK,
               kernel::RESOCT_NODE_VALID);
   }
   EXPECT_EQ(check_state(r, *b, *src), "");
@@ -172,7 +173,7 @@ TEST(Renderer, MoreImportantChannelsLoadFirstWithinALevel) {
   RecordingBackend* b = last_recording_backend();
   b->set_script([&](const FrameTables& t, FrameResult& res, RecordingBackend& rb) {
     for (const auto& slot : t.slots)
-      rb.want(r.page_table(), level0_bricks(r.hierarchy(), slot.slot), res);
+      rb.want(inspect::page_table(r), level0_bricks(r.hierarchy(), slot.slot), res);
   });
   Scene scene = test_scene(0);
   scene.channels.push_back(test_scene(2).channels[0]);
@@ -181,12 +182,12 @@ TEST(Renderer, MoreImportantChannelsLoadFirstWithinALevel) {
   r.render_frame(scene);  // requests; loads 3 bricks: level 2 of both channels, then level 1
   r.render_frame(scene);  // applies them
   auto level1_set = [&](std::uint32_t channel) {
-    const std::uint32_t slot = *r.channel_map().slot_of(channel);
+    const std::uint32_t slot = *inspect::channel_map(r).slot_of(channel);
     int n = 0;
     for (std::uint32_t z = 0; z < 2; ++z)
       for (std::uint32_t y = 0; y < 2; ++y)
         for (std::uint32_t x = 0; x < 2; ++x) {
-          n += r.page_table().entry(PageAddress{slot, 1, {x, y, z}}) !=
+          n += inspect::page_table(r).entry(PageAddress{slot, 1, {x, y, z}}) !=
                        kernel::RESOCT_PAGE_UNMAPPED_WORD
                    ? 1
                    : 0;
@@ -195,8 +196,9 @@ TEST(Renderer, MoreImportantChannelsLoadFirstWithinALevel) {
   };
   EXPECT_EQ(level1_set(2), 1);
   EXPECT_EQ(level1_set(0), 0);
-  EXPECT_NE(r.page_table().entry(PageAddress{*r.channel_map().slot_of(0), 2, {0, 0, 0}}),
-            kernel::RESOCT_PAGE_UNMAPPED_WORD);
+  EXPECT_NE(
+      inspect::page_table(r).entry(PageAddress{*inspect::channel_map(r).slot_of(0), 2, {0, 0, 0}}),
+      kernel::RESOCT_PAGE_UNMAPPED_WORD);
   EXPECT_EQ(check_state(r, *b, *src), "");
 }
 

@@ -28,18 +28,18 @@ TEST(RendererPrefetch, MovingCameraFillsTheHostCacheOnly) {
     EXPECT_EQ(rep.stats.bricks_uploaded, 0u);
     EXPECT_TRUE(rep.failures.empty());
     r.wait_for_loads();
-    EXPECT_LE(r.loader().stats().prefetched, queued);
+    EXPECT_LE(inspect::loader(r).stats().prefetched, queued);
   }
   EXPECT_GT(queued, 0u);
-  EXPECT_GT(r.loader().stats().prefetched, 0u);
-  EXPECT_EQ(r.cache().resident_count(), 0u);  // prefetching never touches the device cache
-  const HostBrickCache& host = r.loader().host_cache();
+  EXPECT_GT(inspect::loader(r).stats().prefetched, 0u);
+  EXPECT_EQ(inspect::cache(r).resident_count(), 0u);  // prefetching never touches the device cache
+  const HostBrickCache& host = inspect::loader(r).host_cache();
   EXPECT_EQ(host.policy_name(), "octreemizer");
   EXPECT_LE(host.bytes(), o.host_cache_bytes);
   EXPECT_GT(host.size(), 0u);
 
   // At rest: two equal poses predict nothing.
-  const auto before = r.loader().stats().prefetched;
+  const auto before = inspect::loader(r).stats().prefetched;
   for (int f = 0; f < 3; ++f) {
     const FrameReport rep = r.render_frame(s);
     if (f > 0) {
@@ -47,7 +47,7 @@ TEST(RendererPrefetch, MovingCameraFillsTheHostCacheOnly) {
     }
     r.wait_for_loads();
   }
-  EXPECT_LE(r.loader().stats().prefetched - before, 16u);  // only the first frame's queue
+  EXPECT_LE(inspect::loader(r).stats().prefetched - before, 16u);  // only the first frame's queue
 }
 
 }  // namespace

@@ -35,7 +35,7 @@ void run_small_cache(std::uint32_t ttl, std::string_view eviction) {
     uploads_per_frame.push_back(u.upload_slots.size());
     ASSERT_EQ(check_state(*rig.renderer, *rig.backend, *src), "") << "frame " << f;
     for (const PageAddress& a : level0_bricks(rig.renderer->hierarchy(), 0)) {
-      if (kernel::resoct_page_is_mapped(rig.renderer->page_table().entry(a))) {
+      if (kernel::resoct_page_is_mapped(inspect::page_table(*rig.renderer).entry(a))) {
         ever_mapped.insert(BrickKey(0, 0, a.brick));
       }
     }
@@ -77,21 +77,21 @@ TEST(RendererProgress, RemapDropsBricksLoadedForTheOldChannel) {
   for (int f = 0; f < 3; ++f) rig.renderer->render_frame(test_scene(0));
   // Frame 3 requested more channel-0 bricks and (synchronously) loaded them; channel 1 now takes
   // the only slot, so they must be dropped, not uploaded.
-  ASSERT_GT(rig.renderer->loader().ready(), 0u);
-  const std::uint64_t epoch = rig.renderer->channel_map().epoch();
+  ASSERT_GT(inspect::loader(*rig.renderer).ready(), 0u);
+  const std::uint64_t epoch = inspect::channel_map(*rig.renderer).epoch();
   const FrameReport rep = rig.renderer->render_frame(test_scene(1));
   EXPECT_GT(rep.stats.stale_loads, 0u);
-  EXPECT_GT(rig.renderer->channel_map().epoch(), epoch);
-  EXPECT_EQ(rig.renderer->channel_map().channel(0), 1u);
+  EXPECT_GT(inspect::channel_map(*rig.renderer).epoch(), epoch);
+  EXPECT_EQ(inspect::channel_map(*rig.renderer).channel(0), 1u);
   ASSERT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
   const ConvergeReport c1 = rig.renderer->render_until_converged(test_scene(1), 100);
   ASSERT_TRUE(c1.converged);
   ASSERT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
   // Back to channel 0: its bricks come from the host cache.
-  const std::uint64_t hits = rig.renderer->loader().stats().host_hits;
+  const std::uint64_t hits = inspect::loader(*rig.renderer).stats().host_hits;
   const ConvergeReport c0 = rig.renderer->render_until_converged(test_scene(0), 100);
   ASSERT_TRUE(c0.converged);
-  EXPECT_GT(rig.renderer->loader().stats().host_hits, hits);
+  EXPECT_GT(inspect::loader(*rig.renderer).stats().host_hits, hits);
   EXPECT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
 }
 
@@ -133,7 +133,7 @@ TEST(RendererProgress, FailedBricksAreReportedOnceAndRenderingGoesOn) {
   EXPECT_EQ(src->reads(bad1), 1);
   EXPECT_EQ(src->reads(bad2), 1);
   EXPECT_EQ(seen.size(), 2u);
-  const auto& pt = rig.renderer->page_table();
+  const auto& pt = inspect::page_table(*rig.renderer);
   EXPECT_EQ(pt.entry(PageAddress{0, 0, bad1.brick()}), kernel::RESOCT_PAGE_UNMAPPED_WORD);
   EXPECT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
 }
@@ -147,7 +147,7 @@ TEST(RendererProgress, LoaderThreadsConvergeToTheSameState) {
   ASSERT_TRUE(rep.converged);
   EXPECT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
   for (const PageAddress& a : level0_bricks(rig.renderer->hierarchy(), 0)) {
-    EXPECT_NE(rig.renderer->page_table().entry(a), kernel::RESOCT_PAGE_UNMAPPED_WORD);
+    EXPECT_NE(inspect::page_table(*rig.renderer).entry(a), kernel::RESOCT_PAGE_UNMAPPED_WORD);
   }
 }
 

@@ -12,6 +12,7 @@
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/renderer_inspection.hpp"
 #include "support/function_source.hpp"
 #include "support/recording_backend.hpp"
 
@@ -114,7 +115,7 @@ struct Rig {
     Renderer* r = renderer.get();
     backend->set_script([r, this](const FrameTables& t, FrameResult& res, RecordingBackend& b) {
       const auto bricks = level0_bricks(r->hierarchy(), t.slots.at(0).slot);
-      b.want(r->page_table(), bricks, res);
+      b.want(inspect::page_table(*r), bricks, res);
       used.push_back(res.used_cache_slots);
     });
   }
@@ -126,17 +127,18 @@ struct Rig {
 /// the first problem or "".
 inline std::string check_renderer_state(const Renderer& r, const RecordingBackend* b,
                                         const BrickSource& src) {
-  if (auto e = r.octree().check_invariants()) return "octree: " + *e;
+  if (auto e = inspect::octree(r).check_invariants()) return "octree: " + *e;
   if (b) {
-    const auto& pool = r.page_table().pool();
+    const auto& pool = inspect::page_table(r).pool();
     if (b->pages().size() < pool.size() ||
         !std::equal(pool.begin(), pool.end(), b->pages().begin()) ||
         !std::all_of(b->pages().begin() + std::ptrdiff_t(pool.size()), b->pages().end(),
                      [](std::uint32_t w) { return w == 0u; })) {
       return "page pool mirror differs from host";
     }
-    if (b->directory() != r.page_table().directory()) return "directory mirror differs from host";
-    const auto words = r.octree().words();
+    if (b->directory() != inspect::page_table(r).directory())
+      return "directory mirror differs from host";
+    const auto words = inspect::octree(r).words();
     if (!std::equal(words.begin(), words.end(), b->nodes().begin(), b->nodes().end())) {
       return "node mirror differs from host";
     }
@@ -144,15 +146,15 @@ inline std::string check_renderer_state(const Renderer& r, const RecordingBacken
   const BrickHierarchy& h = r.hierarchy();
   const std::size_t bytes = h.layout().padded_voxels();
   std::vector<std::byte> voxels(bytes);
-  for (std::uint32_t s = 0; s < r.channel_map().slot_count(); ++s) {
-    const auto ch = r.channel_map().channel(s);
+  for (std::uint32_t s = 0; s < inspect::channel_map(r).slot_count(); ++s) {
+    const auto ch = inspect::channel_map(r).channel(s);
     for (std::uint32_t l = 0; l < h.level_count(); ++l) {
       const glm::uvec3 n = h.level(l).bricks;
       for (std::uint32_t z = 0; z < n.z; ++z)
         for (std::uint32_t y = 0; y < n.y; ++y)
           for (std::uint32_t x = 0; x < n.x; ++x) {
             const PageAddress a{s, l, {x, y, z}};
-            const std::uint32_t e = r.page_table().entry(a);
+            const std::uint32_t e = inspect::page_table(r).entry(a);
             const std::uint32_t state = kernel::resoct_page_state(e);
             if (state == kernel::RESOCT_PAGE_STATE_UNMAPPED) continue;
             if (!ch) return "entry set in an unassigned slot";
@@ -165,11 +167,13 @@ inline std::string check_renderer_state(const Renderer& r, const RecordingBacken
               if (!meta.all_zero()) return where + "EMPTY but not all zero";
             } else if (state == kernel::RESOCT_PAGE_STATE_HOMOGENEOUS) {
               if (!meta.constant || meta.all_zero()) return where + "HOMOGENEOUS but not constant";
-              if (r.page_table().homogeneous_value(a) != meta.min) return where + "wrong value";
+              if (inspect::page_table(r).homogeneous_value(a) != meta.min)
+                return where + "wrong value";
             } else {
               if (meta.constant) return where + "constant brick holds a cache slot";
               const std::uint32_t slot = kernel::resoct_page_cache_slot(e);
-              if (r.cache().key_of(slot) != key) return where + "cache slot holds another key";
+              if (inspect::cache(r).key_of(slot) != key)
+                return where + "cache slot holds another key";
               if (!b) continue;
               src.read_brick(key, voxels);
               const auto dev = b->slot_voxels(slot);
@@ -181,12 +185,12 @@ inline std::string check_renderer_state(const Renderer& r, const RecordingBacken
     }
   }
   // Every resident cache slot is referenced by exactly its page entry.
-  for (std::uint32_t cs = 0; cs < r.cache().slot_count(); ++cs) {
-    const auto key = r.cache().key_of(cs);
+  for (std::uint32_t cs = 0; cs < inspect::cache(r).slot_count(); ++cs) {
+    const auto key = inspect::cache(r).key_of(cs);
     if (!key) continue;
-    const auto addr = r.channel_map().address_of(*key);
+    const auto addr = inspect::channel_map(r).address_of(*key);
     if (!addr) return "resident brick of an invisible channel";
-    const std::uint32_t e = r.page_table().entry(*addr);
+    const std::uint32_t e = inspect::page_table(r).entry(*addr);
     if (!kernel::resoct_page_is_mapped(e) || kernel::resoct_page_cache_slot(e) != cs) {
       return "resident cache slot " + std::to_string(cs) + " not mapped by its page entry";
     }
