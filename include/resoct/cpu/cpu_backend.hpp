@@ -10,7 +10,10 @@
 #include <vector>
 
 #include "resoct/backend/backend.hpp"
-#include "resoct/engine/request_set.hpp"
+
+namespace resoct {
+class RequestSet;  // engine/request_set.hpp: only the backend's .cpp needs it
+}  // namespace resoct
 
 namespace resoct::cpu {
 
@@ -23,9 +26,8 @@ std::unique_ptr<Backend> make_backend(int threads = 0);
 /// initializers in shared libraries are unreliable.
 void register_backend();
 
-/// Device state in host memory. Not thread-safe (one Renderer drives it). Renders of different
-/// CpuBackend instances are serialized, because the kernel's accessors read one process-wide
-/// frame context (no thread-local lookups on the hot path).
+/// Device state in host memory. Not thread-safe (one Renderer drives it). Different CpuBackend
+/// instances render at the same time: each render builds its own kernel context.
 class CpuBackend : public Backend {
  public:
   /// `threads` <= 0: OpenMP's default thread count.
