@@ -196,7 +196,11 @@ int run(const Args& a) {
   if (!a.screenshot.empty()) tools::check_output_path("screenshot", a.screenshot);
   for (const ScriptCommand& c : script) {
     if (c.kind == ScriptCommand::Kind::screenshot || c.kind == ScriptCommand::Kind::save_scene) {
-      tools::check_output_path(c.where, c.text);
+      try {
+        tools::check_output_path(c.where, c.text);
+      } catch (const Error& e) {
+        throw Error(e.code(), c.where + ": " + e.what());
+      }
     }
   }
   const std::shared_ptr<const BrickSource> source(open_source(a.volume, {}, a.source));
@@ -342,7 +346,8 @@ int run(const Args& a) {
     }
     const bool changed = !up_to_date();
     const bool scripted = wait_frames > 0 || converge_cmd != nullptr || pc < script.size();
-    if (!changed && converged && wait_frames == 0) {
+    // --exit-after-frames renders its N frames even when nothing changes (measurements).
+    if (!changed && converged && wait_frames == 0 && a.exit_after_frames == 0) {
       // Converged and nothing to do: sleep until input arrives.
       if (!scripted) glfwWaitEventsTimeout(0.1);
       continue;
@@ -434,7 +439,8 @@ int main(int argc, char** argv) {
   app.add_option("--size", a.size, "window size WxH (default: the scene's viewport, else 800x600)");
   app.add_option("--script", a.script, "command file (docs/viewer.md \"Scripts\")");
   app.add_option("--screenshot", a.screenshot, "PNG of the last frame, written at exit");
-  app.add_option("--exit-after-frames", a.exit_after_frames, "quit after N frames (0 = never)");
+  app.add_option("--exit-after-frames", a.exit_after_frames,
+                 "render N frames, rendering on after convergence, then quit (0 = never)");
   app.add_flag("--verbose", a.verbose, "print every frame's statistics");
   app.add_option("--cache-mb", a.cache_mb, "device brick cache in MiB")->capture_default_str();
   app.add_option("--threads", a.threads, "loader threads (0 = load synchronously)")
