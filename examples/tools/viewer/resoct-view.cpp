@@ -382,7 +382,8 @@ int run(const Args& a) {
                         std::to_string(converge_cmd->count) + " frames");
       }
     }
-    const char* state = converged ? "converged" : changed ? "moving" : "refining";
+    const char* state = changed ? (converged ? "moving, converged" : "moving")
+                                : (converged ? "refining, converged" : "refining");
     char line[256];
     std::snprintf(line, sizeof line,
                   "%.1f ms | requested %llu, loaded %llu, resident %u, in flight %llu | %s",
