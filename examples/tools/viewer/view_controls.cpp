@@ -127,7 +127,10 @@ KeyAction ViewControls::press(const std::string& key) {
   if (key.size() == 1 && key[0] >= '1' && key[0] <= '9') {
     const std::size_t i = std::size_t(key[0] - '1');
     if (i < channels_.size()) {
-      channels_[i].on = !channels_[i].on;
+      // A scene needs one channel: the last visible one stays on.
+      const auto on =
+          std::count_if(channels_.begin(), channels_.end(), [](const Channel& c) { return c.on; });
+      if (!channels_[i].on || on > 1) channels_[i].on = !channels_[i].on;
       selected_ = i;
     }
   } else if (key == "tab") {
