@@ -12,6 +12,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libpng-dev libcli11-dev libcurl4-openssl-dev libblosc-dev libtiff-dev
   python3-matplotlib
+  # resoct-view (examples/tools/viewer/): GLFW; its test runs it under a virtual X server
+  libglfw3-dev xvfb xauth
   # formats tests: OME-Zarr written by the reference implementation, real MRI volumes
   python3-zarr python3-numcodecs python3-numpy mricron-data
   # HTTP tests and bench_http: /usr/bin/python3 runs tests/support/http_test_server.py

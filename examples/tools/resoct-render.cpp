@@ -17,6 +17,7 @@
 #include "resoct/base/error.hpp"
 #include "resoct/base/file_io.hpp"
 #include "resoct/io/open_source.hpp"
+#include "resoct/io/overview_hints.hpp"
 #include "resoct/render/renderer.hpp"
 #include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/overview_scene.hpp"
@@ -223,8 +224,11 @@ int run(const Args& a) {
   if (!a.scene.empty()) from_file = load_scene(a.scene);
   Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
   // Without --scene, the volume's overview: the whole box in view, up to four channels in
-  // distinct colours, each a ramp over its value range (overview_scene.hpp).
-  Scene scene = from_file ? *from_file : overview_scene(renderer.hierarchy().volume());
+  // distinct colours, each a ramp over its value range or, where the source's metadata has
+  // them, its OMERO colour and window (overview_scene.hpp, io/overview_hints.hpp).
+  Scene scene = from_file ? *from_file
+                          : overview_scene(renderer.hierarchy().volume(), Viewport{},
+                                           overview_hints(renderer.source()));
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
   // Checked before rendering, naming the option rather than the scene field.

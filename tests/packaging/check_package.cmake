@@ -31,6 +31,19 @@ foreach(f include/resoct/volume/hierarchy.hpp include/resoct/version.hpp
   endif()
 endforeach()
 
+# The command-line tools install beside each other (resoct-view where GLFW was found).
+if(EXPECT_TOOLS)
+  set(tools resoct-render resoct-convert resoct-info)
+  if(EXPECT_VIEWER)
+    list(APPEND tools resoct-view)
+  endif()
+  foreach(t IN LISTS tools)
+    if(NOT EXISTS ${prefix}/bin/${t})
+      message(FATAL_ERROR "install tree lacks bin/${t}")
+    endif()
+  endforeach()
+endif()
+
 string(REPLACE ";" "\\;" comps "${COMPONENTS}")
 set(toolchain)
 if(CONSUMER_CXX_COMPILER)

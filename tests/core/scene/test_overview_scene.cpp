@@ -62,6 +62,51 @@ TEST(OverviewScene, FirstChannelsVisibleInColoursOfTheirOwn) {
   EXPECT_RESOCT_ERROR(overview_scene(v, Viewport{0, 10}), ErrorCode::invalid_argument, "viewport");
 }
 
+// Hints from the data: a window (in the file's units) or histogram percentiles set the ramp, a
+// colour replaces the palette's; without hints the overview is unchanged.
+TEST(OverviewScene, TransferFunctionsFromHints) {
+  VolumeDesc v = volume({32, 32, 32}, 3);
+  v.type = VoxelType::u16;
+  v.data_type = DataType::i16;  // stored = file + 32768
+  v.ranges = {{32768.0 - 1000.0, 32768.0 + 3000.0}, {0.0, 100.0}, {0.0, 100.0}};
+  OverviewHints h;
+  h.channels.resize(3);
+  h.channels[0].window = ValueRange{0.0, 2000.0};  // file units: 0.25 .. 0.75 of the range
+  h.channels[0].colour = glm::dvec3(1.0, 0.5, 0.0);
+  // Channel 1: 10 bins, half the values in bin 0, the rest spread over bins 4..8.
+  h.channels[1].histogram = {500, 0, 0, 0, 100, 100, 100, 100, 100, 0};
+  const Scene s = overview_scene(v, Viewport{64, 64}, h);
+  ASSERT_EQ(s.channels.size(), 3u);
+  const TransferFunction& w = s.channels[0].tf;
+  EXPECT_EQ(w.evaluate(0.25).a, 0.0);
+  EXPECT_GT(w.evaluate(0.26).a, 0.0);
+  EXPECT_NEAR(w.evaluate(0.5).a, 0.25, 1e-12);
+  EXPECT_EQ(w.evaluate(0.75), glm::dvec4(1.0, 0.5, 0.0, 0.5));
+  EXPECT_EQ(w.evaluate(1.0), glm::dvec4(1.0, 0.5, 0.0, 0.5));
+  // 50th percentile: the top of bin 0 (0.1); 99.5th: 95 % into bin 8 (0.895).
+  const TransferFunction& p = s.channels[1].tf;
+  EXPECT_EQ(p.evaluate(0.1).a, 0.0);
+  EXPECT_GT(p.evaluate(0.11).a, 0.0);
+  EXPECT_NEAR(p.evaluate(0.895).a, 0.5, 1e-12);
+  EXPECT_NEAR(histogram_percentile(h.channels[1].histogram, 50.0).value(), 0.1, 1e-12);
+  EXPECT_NEAR(histogram_percentile(h.channels[1].histogram, 99.5).value(), 0.895, 1e-12);
+  EXPECT_FALSE(histogram_percentile({0, 0, 0}, 50.0).has_value());
+  // Channel 2 has no hint: the default ramp, as without hints.
+  EXPECT_EQ(s.channels[2].tf, overview_scene(v, Viewport{64, 64}).channels[2].tf);
+  EXPECT_EQ(overview_scene(v, Viewport{64, 64}, {}), overview_scene(v, Viewport{64, 64}));
+  // A window outside the range is ignored; a bad colour is an error naming "hints".
+  OverviewHints outside;
+  outside.channels.resize(1);
+  outside.channels[0].window = ValueRange{5000.0, 6000.0};
+  EXPECT_EQ(overview_scene(v, Viewport{64, 64}, outside).channels[0].tf,
+            overview_scene(v, Viewport{64, 64}).channels[0].tf);
+  OverviewHints bad;
+  bad.channels.resize(1);
+  bad.channels[0].colour = glm::dvec3(2.0, 0.0, 0.0);
+  EXPECT_RESOCT_ERROR(overview_scene(v, Viewport{64, 64}, bad), ErrorCode::invalid_argument,
+                      "hints");
+}
+
 TEST(Orbit, TurnsTheEyeAboutUpThroughTheTarget) {
   Camera c;
   c.eye = {1.5, 0.5, 0.5};

@@ -16,6 +16,8 @@
 #include <nlohmann/json.hpp>
 
 #include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/io/overview_hints.hpp"
+#include "resoct/sources/procedural_source.hpp"
 #include "resoct/sources/in_memory_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/generated_data.hpp"
@@ -227,6 +229,28 @@ TEST(OmeZarr, OmeroWindowsAreChannelRanges) {
   EXPECT_EQ(src->array(0).compressor, ZarrCompressor::zlib);
   // The finest dataset's translation (c, z, y, x) places the corner of voxel 0 (x, y, z).
   EXPECT_EQ(src->volume().origin, glm::dvec3(3.0, -2.0, 1.5));
+}
+
+// overview_hints: OMERO colours and windows become the overview's transfer functions.
+TEST(OmeZarr, OmeroColoursAndWindowsAreOverviewHints) {
+  const auto src = open_ome_zarr(data_dir() + "/omero.zarr", BrickLayout{glm::uvec3(4), 1});
+  const OverviewHints hints = overview_hints(*src);
+  ASSERT_EQ(hints.channels.size(), 2u);
+  EXPECT_EQ(hints.channels[0].window, (ValueRange{100.0, 4000.0}));
+  ASSERT_TRUE(hints.channels[1].colour.has_value());
+  EXPECT_EQ(*hints.channels[1].colour, glm::dvec3(0.0, 1.0, 0.0));
+  const Scene s = overview_scene(src->volume(), Viewport{64, 48}, hints);
+  ASSERT_EQ(s.channels.size(), 2u);
+  // The window is the whole range here (the range is the window): the ramp starts at 0.
+  EXPECT_EQ(s.channels[0].tf.evaluate(0.0).a, 0.0);
+  EXPECT_GT(s.channels[0].tf.evaluate(0.05).a, 0.0);
+  EXPECT_EQ(s.channels[1].tf.evaluate(1.0), glm::dvec4(0.0, 1.0, 0.0, 0.5));
+  // Sources without display metadata give no hints.
+  EXPECT_TRUE(
+      overview_hints(*make_procedural_source("procedural:tubes:16x16x16:2", {})).channels.empty());
+  EXPECT_EQ(parse_hex_colour("#ff8000"), glm::dvec3(1.0, 128.0 / 255.0, 0.0));
+  EXPECT_FALSE(parse_hex_colour("12345").has_value());
+  EXPECT_FALSE(parse_hex_colour("GG0000").has_value());
 }
 
 /// Any ByteStore works (the HTTP store included); this one counts chunk reads.
