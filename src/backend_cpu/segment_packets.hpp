@@ -52,8 +52,8 @@ inline v4f clamp_coord4(v4f v, float hi) {
 
 // trilinear<T> (kernel_access.hpp) at four positions: the same clamps, cell and lerps per lane.
 template <class T>
-[[gnu::always_inline]] inline v4f trilinear4(const std::byte* brick, const BrickGeometry& g,
-                                             v4f px, v4f py, v4f pz) {
+[[gnu::always_inline]] inline v4f trilinear4(const std::byte* brick, const BrickGeometry& g, v4f px,
+                                             v4f py, v4f pz) {
   const v4f cx = clamp_coord4(px - splat(0.5f), g.hi.x);
   const v4f cy = clamp_coord4(py - splat(0.5f), g.hi.y);
   const v4f cz = clamp_coord4(pz - splat(0.5f), g.hi.z);
@@ -109,10 +109,10 @@ inline v4f correct_opacity4(v4f alpha, v4f ratio) {
   }
   const v4f y = ratio * la;
   v4f r =
-      -y * (one + y * (splat(0.5f) +
-                       y * (splat(0.16666667f) +
-                            y * (splat(0.041666668f) +
-                                 y * (splat(0.0083333333f) + y * splat(0.0013888889f))))));
+      -y *
+      (one + y * (splat(0.5f) + y * (splat(0.16666667f) +
+                                     y * (splat(0.041666668f) +
+                                          y * (splat(0.0083333333f) + y * splat(0.0013888889f))))));
   const v4i e_libm = valid & ~(y > splat(-RESOCT_SERIES_LIMIT));
   for (int l = 0; l < 4; ++l) {
     if (e_libm[l] != 0) r[l] = resoct_one_minus_exp(y[l]);
