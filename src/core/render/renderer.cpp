@@ -10,11 +10,11 @@
 
 #include <glm/vec3.hpp>
 
+#include "renderer_impl.hpp"
 #include "resoct/base/error.hpp"
 #include "resoct/engine/prefetch.hpp"
 #include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
-#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
@@ -23,208 +23,13 @@ namespace resoct {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// A camera position read by loader threads (host cache Octreemizer distances).
-struct SharedEye {
-  std::mutex mutex;
-  glm::dvec3 eye{0.0};
-};
+using detail::page_unmapped;
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-const BrickSource& checked_source(const std::shared_ptr<const BrickSource>& s) {
-  if (!s) throw invalid_parameter("source", "must not be null");
-  return *s;
-}
-
-std::uint32_t slot_count_for(const RendererOptions& o, const BrickSource& s) {
-  if (o.visible_slots != 0) return o.visible_slots;
-  return std::min(s.volume().channels, kernel::RESOCT_MAX_SLOTS);
-}
-
-// The sparse page table's pool capacity (RendererOptions::page_pool_blocks).
-std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
-                              std::uint32_t slots) {
-  const std::uint64_t total = PageTable::block_count(h, slots);
-  const std::uint64_t slot_bytes = h.layout().padded_voxels() * voxel_size(h.volume().type);
-  const std::uint64_t cache_slots = o.device_cache_bytes / slot_bytes;
-  constexpr std::uint64_t kMax = kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS - 1u;
-  std::uint64_t blocks = o.page_pool_blocks;
-  if (blocks == 0) {
-    blocks = std::min(total, cache_slots + std::max<std::uint64_t>(cache_slots / 2u, 64u));
-    blocks = std::min(blocks, kMax);
-  }
-  if (blocks > kMax) {
-    throw invalid_parameter("page_pool_blocks", std::to_string(blocks) + " exceeds the " +
-                                                    std::to_string(kMax) +
-                                                    " blocks 32-bit request keys address");
-  }
-  if (blocks < total && blocks <= cache_slots) {
-    throw invalid_parameter("page_pool_blocks",
-                            std::to_string(blocks) + " blocks must exceed the device cache's " +
-                                std::to_string(cache_slots) + " slots (or cover all " +
-                                std::to_string(total) +
-                                " blocks); raise it or lower device_cache_bytes");
-  }
-  return std::uint32_t(blocks);
-}
-
-// Options are validated before the policies are made, so `policy` is one of the two.
-std::unique_ptr<EvictionPolicy> make_policy(Eviction policy, const BrickHierarchy& h,
-                                            const glm::dvec3* camera) {
-  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
-  // Distances in physical units from the camera of the frame being rendered.
-  return std::make_unique<OctreemizerPolicy>(
-      h.level_count(), OctreemizerWeights{},
-      [&h, camera](BrickKey key) { return brick_camera_distance(h, key, *camera); });
-}
-
-std::unique_ptr<EvictionPolicy> make_host_policy(Eviction policy, const BrickHierarchy& h,
-                                                 std::shared_ptr<SharedEye> eye) {
-  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
-  return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
-                                             [&h, eye](BrickKey key) {
-                                               glm::dvec3 e;
-                                               {
-                                                 std::lock_guard lock(eye->mutex);
-                                                 e = eye->eye;
-                                               }
-                                               return brick_camera_distance(h, key, e);
-                                             });
-}
-
-// Checked first, before any structure is built.
-RendererOptions validated(RendererOptions o, const Backend* backend) {
-  if (backend == nullptr) throw invalid_parameter("backend", "must not be null");
-  o.validate();
-  return o;
-}
-
-bool page_unmapped(std::uint32_t entry) {
-  return kernel::resoct_page_state(entry) == kernel::RESOCT_PAGE_STATE_UNMAPPED;
-}
-
-std::unique_ptr<Backend> named_backend(const RendererOptions& options) {
-  options.validate();  // before creating a device for options that would be refused anyway
-  return create_backend(options.backend, options.backend_options);
-}
-
 }  // namespace
-
-// The Renderer's state and the frame loop's steps; the Renderer forwards to it.
-struct Renderer::Impl {
-  Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
-       RendererOptions options);
-
-  std::uint32_t timepoints() const noexcept { return source_->timepoints(); }
-  void render_frame(const Scene& scene, FrameReport& report);
-
-  const FrameTables& frame_tables(const Scene& scene);
-  void take_pixels(FrameReport& report);
-  void assign_channels(const Scene& scene);
-  void switch_timepoint(std::uint32_t t);
-  /// Bricks of the next timepoint the scene's view may need, for PrefetchOptions::next_timepoint.
-  void prefetch_next_timepoint(const Scene& scene, std::size_t max,
-                               std::vector<TimedBrickKey>& keys);
-  void apply_loaded(FrameStats& stats);
-  bool apply_one(const LoadedBrick& b, FrameStats& stats);
-  void evict(BrickKey key);
-  void send_update(FrameStats& stats);
-  void answer_nodes(FrameStats& stats);
-  bool handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats);
-  void prefetch(const Scene& scene, FrameStats& stats);
-  void report_failures(FrameReport& report);
-
-  std::shared_ptr<const BrickSource> source_;
-  // The shown timepoint and its source (region metadata is per timepoint).
-  std::uint32_t timepoint_ = 0;
-  std::shared_ptr<const BrickSource> timepoint_source_;
-  RendererOptions options_;
-  BrickHierarchy hierarchy_;
-  OctreeLayout layout_;
-  PageTable pages_;
-  ChannelMap channels_;
-  std::unique_ptr<BrickCache> cache_;
-  std::unique_ptr<ResidencyOctree> octree_;
-  std::unique_ptr<BrickLoader> loader_;
-  std::unique_ptr<Backend> backend_;
-  BackendConfig config_;
-  std::function<void(const LoadFailure&)> on_failure_;
-
-  std::vector<std::uint32_t> channel_rank_;  // per dataset channel: load rank in this scene
-  glm::dvec3 camera_{0.0};                   // eye in physical units (Octreemizer distances)
-  // The same for the host cache's policy, which runs on loader threads.
-  std::shared_ptr<SharedEye> host_camera_ = std::make_shared<SharedEye>();
-  CameraPredictor predictor_;
-  std::uint64_t frame_ = 0;
-  bool send_full_ = true;                      // next update carries full arrays
-  std::vector<LoadedBrick> staged_;            // loaded, waiting for budget or a free slot
-  std::vector<std::uint32_t> pending_nodes_;   // node requests to answer next frame
-  std::vector<std::uint32_t> pending_blocks_;  // page-table blocks to allocate next frame
-  // Requested bricks -> frame of their first request in an unbroken run of frames (ageing).
-  std::unordered_map<BrickKey, std::uint64_t> waiting_since_;
-  std::vector<std::byte> scratch_;  // keeps the voxels of this frame's uploads alive
-  std::vector<std::shared_ptr<const HostBrick>> upload_data_;
-  std::vector<BrickUpload> uploads_;
-  FrameTables tables_;
-  FrameResult result_;
-};
-
-Renderer::Renderer(std::shared_ptr<const BrickSource> source, RendererOptions options)
-    : Renderer(std::move(source), named_backend(options), options) {}
-
-Renderer::Renderer(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
-                   RendererOptions options)
-    : impl_(std::make_unique<Impl>(std::move(source), std::move(backend), std::move(options))) {}
-
-Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<Backend> backend,
-                     RendererOptions options)
-    : source_(std::move(source)),
-      options_(validated(std::move(options), backend.get())),
-      hierarchy_(checked_source(source_).hierarchy()),
-      layout_(hierarchy_.volume().extent, options_.leaf_size),
-      pages_(hierarchy_, slot_count_for(options_, *source_),
-             pool_blocks_for(options_, hierarchy_, slot_count_for(options_, *source_))),
-      channels_(pages_.slot_count(), hierarchy_.volume().channels) {
-  cache_ = std::make_unique<BrickCache>(hierarchy_.layout(), hierarchy_.volume().type,
-                                        options_.device_cache_bytes, options_.ttl,
-                                        make_policy(options_.eviction, hierarchy_, &camera_));
-  // Residency means "sampling needs no cache miss": EMPTY and HOMOGENEOUS entries qualify as
-  // well as MAPPED ones, so the traversal may use such a level without touching the cache.
-  octree_ = std::make_unique<ResidencyOctree>(
-      hierarchy_, layout_, pages_.slot_count(),
-      [this](std::uint32_t slot, std::uint32_t level, glm::uvec3 brick) {
-        return !page_unmapped(pages_.entry(PageAddress{slot, level, brick}));
-      });
-  loader_ = std::make_unique<BrickLoader>(
-      source_, options_.loader_threads, options_.host_cache_bytes,
-      make_host_policy(options_.host_eviction, hierarchy_, host_camera_));
-  loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
-  timepoint_ = source_->timepoint();
-  timepoint_source_ = source_;
-  backend_ = std::move(backend);
-  config_.voxel_type = hierarchy_.volume().type;
-  config_.padded_brick = hierarchy_.layout().padded_size();
-  config_.cache_slots = cache_->slot_count();
-  config_.page_pool_blocks = pages_.pool_block_count();
-  config_.directory_entries = std::uint32_t(pages_.directory().size());
-  config_.page_tables = pages_.table_count();
-  config_.node_words = octree_->words().size();
-  config_.brick_request_capacity = options_.brick_request_capacity;
-  config_.node_request_capacity = options_.node_request_capacity;
-  {
-    // min(max_bricks x brick bytes, max_bytes) without overflowing the "unlimited" defaults.
-    const std::uint64_t brick =
-        hierarchy_.layout().padded_voxels() * voxel_size(hierarchy_.volume().type);
-    const std::uint64_t b = options_.upload_budget.max_bricks;
-    const std::uint64_t by_count =
-        b > std::numeric_limits<std::uint64_t>::max() / brick ? ~0ull : b * brick;
-    config_.upload_bytes_per_frame = std::min(by_count, options_.upload_budget.max_bytes);
-  }
-  backend_->configure(config_);
-}
 
 Renderer::~Renderer() = default;
 
@@ -718,40 +523,5 @@ ConvergeReport Renderer::render_until_converged(const Scene& scene, std::uint32_
   out.last.failures = std::move(failures);
   return out;
 }
-
-namespace inspect {
-
-// The one friend of Renderer: the functions below reach its Impl through it.
-struct Access {
-  static const Renderer::Impl& impl(const Renderer& r) noexcept { return *r.impl_; }
-  static Renderer::Impl& impl(Renderer& r) noexcept { return *r.impl_; }
-};
-
-const OctreeLayout& layout(const Renderer& r) noexcept {
-  return Access::impl(r).layout_;
-}
-const PageTable& page_table(const Renderer& r) noexcept {
-  return Access::impl(r).pages_;
-}
-const BrickCache& cache(const Renderer& r) noexcept {
-  return *Access::impl(r).cache_;
-}
-const ResidencyOctree& octree(const Renderer& r) noexcept {
-  return *Access::impl(r).octree_;
-}
-const ChannelMap& channel_map(const Renderer& r) noexcept {
-  return Access::impl(r).channels_;
-}
-const BrickLoader& loader(const Renderer& r) noexcept {
-  return *Access::impl(r).loader_;
-}
-Backend& backend(Renderer& r) noexcept {
-  return *Access::impl(r).backend_;
-}
-const BackendConfig& backend_config(const Renderer& r) noexcept {
-  return Access::impl(r).config_;
-}
-
-}  // namespace inspect
 
 }  // namespace resoct
