@@ -341,7 +341,8 @@ int main(int argc, char** argv) {
   resoct::tools::add_source_options(app, a.source);
   app.add_option("--scene", a.scene,
                  "scene JSON (docs/scene.md); without it, an overview of the whole volume "
-                 "(up to 4 channels, each a colour ramp over its value range)");
+                 "(up to 4 channels, each a colour ramp over its value range, or its OMERO colour "
+                 "and window where the metadata has them)");
   app.add_option("--backend", a.backend, "cpu | vulkan (when built) | registered backend name")
       ->capture_default_str();
   app.add_option("--device", a.device, "Vulkan device index or name substring");

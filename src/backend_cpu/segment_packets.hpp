@@ -95,14 +95,13 @@ template <class T>
 inline v4f correct_opacity4(v4f alpha, v4f ratio) {
   using namespace kernel;
   const v4f one = splat(1.0f);
-  const v4f la_series =
-      -alpha *
-      (one + alpha * (splat(0.5f) +
-                      alpha * (splat(0.33333333f) +
-                               alpha * (splat(0.25f) +
-                                        alpha * (splat(0.2f) + alpha * splat(0.16666667f))))));
-  const v4i valid = (alpha > splat(0.0f)) & (ratio > splat(0.0f)) & ~(alpha >= one);
-  v4f la = la_series;
+  v4f la = -alpha *
+           (one + alpha * (splat(0.5f) +
+                           alpha * (splat(0.33333333f) +
+                                    alpha * (splat(0.25f) +
+                                             alpha * (splat(0.2f) + alpha * splat(0.16666667f))))));
+  const v4i positive = (alpha > splat(0.0f)) & (ratio > splat(0.0f));
+  const v4i valid = positive & ~(alpha >= one);
   const v4i la_libm = valid & ~(alpha < splat(RESOCT_SERIES_LIMIT));
   for (int l = 0; l < 4; ++l) {
     if (la_libm[l] != 0) la[l] = resoct_log_one_minus(alpha[l]);
@@ -121,8 +120,7 @@ inline v4f correct_opacity4(v4f alpha, v4f ratio) {
   r = select(r < splat(0.0f), splat(0.0f), r);
   r = select(one < r, one, r);
   // Invalid lanes: 1 where the reference alpha is at least 1, else 0.
-  const v4i full = (alpha > splat(0.0f)) & (ratio > splat(0.0f)) & (alpha >= one);
-  return select(valid, r, select(full, one, splat(0.0f)));
+  return select(valid, r, select(positive & (alpha >= one), one, splat(0.0f)));
 }
 
 inline v4f load4(const glm::vec4& v) {
