@@ -18,6 +18,7 @@
 #include "resoct/base/file_io.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/io/overview_hints.hpp"
+#include "resoct/render/frame_accumulator.hpp"
 #include "resoct/render/renderer.hpp"
 #include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/overview_scene.hpp"
@@ -51,6 +52,7 @@ struct Args {
   std::string stats;
   std::uint32_t frames = 0;
   bool converge = false;
+  std::uint32_t accumulate = 0;  // --accumulate N: jittered frames averaged after convergence
   std::uint32_t max_frames = 1000;
   std::uint32_t steady_frames = 5;
   std::uint64_t cache_mb = 512;
@@ -201,6 +203,10 @@ int run(const Args& a) {
   o.retry_failed_after_ms = a.retry_failed_ms;
   if (a.leaf == 0) throw invalid_parameter("leaf", "must be > 0");
   o.leaf_size = glm::uvec3(a.leaf);
+  if (a.accumulate > 4096) throw invalid_parameter("accumulate", "must be 0..4096");
+  if (a.accumulate > 1 && !a.converge) {
+    throw invalid_parameter("accumulate", "needs --converge (it averages the converged view)");
+  }
   if (a.frames == 0 && !a.converge)
     throw invalid_parameter("frames", "give --frames N or --converge");
   std::optional<std::pair<std::uint32_t, std::uint32_t>> play;
@@ -297,6 +303,24 @@ int run(const Args& a) {
   } else {
     render_image();
   }
+  // --accumulate N: the converged frame and N - 1 jittered ones averaged (FrameAccumulator; the
+  // average restarts if a jittered frame brings new bricks, as in resoct-view).
+  std::optional<FrameAccumulator> acc;
+  if (a.accumulate > 1 && !play) {
+    acc.emplace(a.accumulate);
+    acc->next(scene);
+    acc->add(last.image, false);
+    for (std::uint32_t i = 0; !acc->done() && i < 4 * a.accumulate + a.max_frames; ++i) {
+      const FrameJitter j = acc->next(scene);
+      renderer.render_frame(scene, last, j);
+      ++frames;
+      totals.add(last);
+      std::fprintf(stderr, "%s\n", format_frame_line(last.stats).c_str());
+      acc->add(last);
+      if (!last.converged) renderer.wait_for_loads();
+    }
+    std::fprintf(stderr, "resoct-render: accumulated %u jittered frames\n", acc->frames());
+  }
   // Steady state: extra frames after convergence, which load and upload nothing.
   for (std::uint32_t i = 0; a.converge && converged && i < a.steady_frames; ++i) {
     frame();
@@ -323,7 +347,7 @@ int run(const Args& a) {
     }
   }
 #endif
-  if (!a.out.empty() && !play) write_png(last.image, a.out);
+  if (!a.out.empty() && !play) write_png(acc ? acc->image() : last.image, a.out);
   if (!a.stats.empty()) {
     write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer, played);
   }
@@ -357,6 +381,9 @@ int main(int argc, char** argv) {
   app.add_flag("--converge", a.converge, "render until converged (capped by --max-frames)")
       ->excludes(frames);
   app.add_option("--max-frames", a.max_frames, "frame cap of --converge")->capture_default_str();
+  app.add_option("--accumulate", a.accumulate,
+                 "with --converge: average the converged frame and N - 1 jittered ones "
+                 "(docs/rendering.md \"Jittered accumulation\"; not with --play)");
   app.add_option("--steady-frames", a.steady_frames, "frames averaged for ms_per_frame_steady")
       ->capture_default_str();
   app.add_option("--cache-mb", a.cache_mb, "device brick cache in MiB")->capture_default_str();

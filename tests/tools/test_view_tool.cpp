@@ -9,6 +9,7 @@
 // fail when RESOCT_REQUIRE_VULKAN=1 (CI).
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -17,6 +18,7 @@
 
 #include "core/io/store/test_brick_store_util.hpp"
 #include "resoct/backend/image.hpp"
+#include "support/generated_data.hpp"
 #include "support/tool_process.hpp"
 #include "support/vulkan_required.hpp"
 
@@ -122,6 +124,17 @@ TEST_F(ViewTool, ScriptedSessionMatchesRenderUnderValidation) {
                  "save-scene " +
                  f("final.json") +
                  "\n"
+                 "# the still view averaged (16 jittered frames), a timepoint key on a volume\n"
+                 "# without a t axis (nothing changes), the panel off and on again\n"
+                 "wait-accumulated\n"
+                 "screenshot " +
+                 f("accumulated.png") +
+                 "\n"
+                 "key t\n"
+                 "key T\n"
+                 "key f1\n"
+                 "key f1\n"
+                 "wait 2\n"
                  "quit\n");
   const ToolRun r = view(dir, std::string("--volume ") + kVolume +
                                   " --size 160x120 --backend vulkan --validation --threads 2 "
@@ -164,6 +177,86 @@ TEST_F(ViewTool, ScriptedSessionMatchesRenderUnderValidation) {
   ASSERT_EQ(e.exit_code, 0) << e.err;
   const resoct::Image expected = resoct::read_png(f("expected.png"));
   EXPECT_LE(max_abs_diff(final_img, expected), 2.0 / 255.0 + 1e-6);
+
+  // The accumulated still equals resoct-render --accumulate 16 of the same view, and differs
+  // from the single frame (the jitter reached the device).
+  const ToolRun acc = resoct::test::run_tool_process(
+      dir.path().string(), RESOCT_RENDER,
+      std::string("--volume ") + kVolume + " --scene " + shell_quote(f("final.json")) +
+          " --backend vulkan --converge --accumulate 16 --threads 2 --out " +
+          shell_quote(f("expected_acc.png")));
+  ASSERT_EQ(acc.exit_code, 0) << acc.err;
+  const resoct::Image accumulated = resoct::read_png(f("accumulated.png"));
+  const double acc_vs_render = max_abs_diff(accumulated, resoct::read_png(f("expected_acc.png")));
+  const double acc_vs_frame = max_abs_diff(accumulated, final_img);
+  std::printf("[ view ] accumulated vs resoct-render --accumulate: %.4f, vs one frame: %.4f\n",
+              acc_vs_render, acc_vs_frame);
+  EXPECT_LE(acc_vs_render, 2.0 / 255.0 + 1e-6);
+  EXPECT_GT(acc_vs_frame, 4.0 / 255.0);
+}
+
+// The statistics panel (F1) covers only its rectangle at the top-left corner: window
+// screenshots with it on and off differ there and nowhere else. Also --half-res-moving.
+TEST_F(ViewTool, PanelChangesOnlyItsRectangle) {
+  require_display();
+  if (IsSkipped() || HasFatalFailure()) return;
+  TempDir dir;
+  const auto f = [&](const char* name) { return dir.file(name); };
+  write_file(f("p.txt"), "wait-converged\nwindow-screenshot " + f("on.png") +
+                             "\nkey f1\nwindow-screenshot " + f("off.png") +
+                             "\norbit 20 0\nwait 1\nwait-converged\nquit\n");
+  const ToolRun r = view(dir, std::string("--volume ") + kVolume +
+                                  " --size 480x200 --backend cpu --threads 2 --accumulate 0"
+                                  " --half-res-moving --verbose --script " +
+                                  shell_quote(f("p.txt")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The orbit's frame is rendered at half the size, the converged one at the full size.
+  EXPECT_NE(r.err.find("240x100: "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("half resolution"), std::string::npos) << r.err;
+  const resoct::Image on = resoct::read_png(f("on.png"));
+  const resoct::Image off = resoct::read_png(f("off.png"));
+  ASSERT_EQ(on.width(), 480u);
+  ASSERT_EQ(off.height(), 200u);
+  // The panel: 4 lines of 2x-scaled 5x7 glyphs (18 px per line, 6 px padding) at (8, 8).
+  const std::uint32_t x0 = 8, y0 = 8, y1 = 8 + 4 * 18 - 4 + 2 * 6;
+  std::size_t inside = 0, outside = 0;
+  std::uint32_t min_x = 480, min_y = 200;
+  for (std::uint32_t y = 0; y < 200; ++y) {
+    for (std::uint32_t x = 0; x < 480; ++x) {
+      if (on.at(x, y) == off.at(x, y)) continue;
+      min_x = std::min(min_x, x);
+      min_y = std::min(min_y, y);
+      (x >= x0 && y >= y0 && y < y1 ? inside : outside) += 1;
+    }
+  }
+  EXPECT_EQ(outside, 0u);
+  EXPECT_GT(inside, 2000u);
+  EXPECT_EQ(min_x, x0);
+  EXPECT_EQ(min_y, y0);
+}
+
+// Time series: 't' / 'T' step through the timepoints, wrapping.
+TEST_F(ViewTool, TimepointKeysStepThroughASeries) {
+  require_display();
+  if (IsSkipped() || HasFatalFailure()) return;
+  const std::string data = resoct::test::python_generated_dir(
+      RESOCT_BINARY_DIR "/test-data", "ome-zarr", RESOCT_SOURCE_DIR "/tests/data/make_ome_zarr.py");
+  ASSERT_FALSE(data.empty());
+  // t = 3 timepoints of 6 x 7 x 8 u8 (tests/data/make_ome_zarr.py).
+  const std::string volume = shell_quote(data + "/blosc-lz4-shuffle_leu1_small_tzyx.zarr");
+  TempDir dir;
+  const auto f = [&](const char* name) { return dir.file(name); };
+  write_file(f("t.txt"),
+             "wait-converged\nscreenshot " + f("t0.png") + "\nkey t\nwait-converged\nscreenshot " +
+                 f("t1.png") + "\nsave-scene " + f("t1.json") +
+                 "\nkey T\nkey pageup\nwait-converged\nsave-scene " + f("t2.json") + "\nquit\n");
+  const ToolRun r =
+      view(dir, "--volume " + volume + " --size 64x64 --backend cpu --threads 2 --script " +
+                    shell_quote(f("t.txt")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(resoct::test::slurp(f("t1.json")))["timepoint"], 1);
+  EXPECT_EQ(nlohmann::json::parse(resoct::test::slurp(f("t2.json")))["timepoint"], 2);
+  EXPECT_GT(max_abs_diff(resoct::read_png(f("t0.png")), resoct::read_png(f("t1.png"))), 0.0);
 }
 
 // The CPU backend's frames reach the window through a staging buffer; the converged screenshot
@@ -173,17 +266,20 @@ TEST_F(ViewTool, CpuBackendScreenshotMatchesRender) {
   if (IsSkipped() || HasFatalFailure()) return;
   TempDir dir;
   const auto f = [&](const char* name) { return dir.file(name); };
-  write_file(f("s.txt"), "orbit -30 -10\nwait-converged\nsave-scene " + f("s.json") + "\n");
+  // --exit-after-frames renders on after the accumulation (4 frames) is done.
+  write_file(f("s.txt"),
+             "orbit -30 -10\nwait-converged\nsave-scene " + f("s.json") + "\nwait-accumulated\n");
   const ToolRun r =
       view(dir, std::string("--volume ") + kVolume +
-                    " --size 96x80 --backend cpu --threads 2 --script " + shell_quote(f("s.txt")) +
-                    " --exit-after-frames 30" + " --screenshot " + shell_quote(f("cpu.png")));
+                    " --size 96x80 --backend cpu --threads 2 --accumulate 4 --script " +
+                    shell_quote(f("s.txt")) + " --exit-after-frames 60" + " --screenshot " +
+                    shell_quote(f("cpu.png")));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find(", converged"), std::string::npos) << r.err;
   const ToolRun e = resoct::test::run_tool_process(
       dir.path().string(), RESOCT_RENDER,
       std::string("--volume ") + kVolume + " --scene " + shell_quote(f("s.json")) +
-          " --converge --threads 2 --out " + shell_quote(f("expected.png")));
+          " --converge --accumulate 4 --threads 2 --out " + shell_quote(f("expected.png")));
   ASSERT_EQ(e.exit_code, 0) << e.err;
   EXPECT_LE(max_abs_diff(resoct::read_png(f("cpu.png")), resoct::read_png(f("expected.png"))),
             2.0 / 255.0 + 1e-6);
@@ -197,6 +293,7 @@ TEST_F(ViewTool, BadInputFailsWithOneLine) {
   write_file(dir.file("bad_number.txt"), "# comment\norbit 10 x\n");
   write_file(dir.file("bad_key.txt"), "key F13\n");
   write_file(dir.file("bad_wait.txt"), "wait 0\n");
+  write_file(dir.file("bad_acc.txt"), "wait-accumulated 0\n");
   write_file(dir.file("bad_shot.txt"), "screenshot " + dir.file("no/such/dir/a.png") + "\n");
   const std::string vol = std::string("--volume ") + kVolume + " ";
   const struct {
@@ -215,6 +312,8 @@ TEST_F(ViewTool, BadInputFailsWithOneLine) {
       {vol + "--script " + dir.file("bad_number.txt"), "bad_number.txt:2: orbit"},
       {vol + "--script " + dir.file("bad_key.txt"), "bad_key.txt:1: key: unknown key 'F13'"},
       {vol + "--script " + dir.file("bad_wait.txt"), "bad_wait.txt:1: wait"},
+      {vol + "--script " + dir.file("bad_acc.txt"), "bad_acc.txt:1: wait-accumulated"},
+      {vol + "--accumulate 5000", "accumulate"},
       {vol + "--script " + dir.file("bad_shot.txt"), "bad_shot.txt:1"},
       {vol + "--scene " + dir.file("none.json"), "none.json"},
       {vol + "--screenshot " + dir.file("no/dir/x.png"), "no/dir"},

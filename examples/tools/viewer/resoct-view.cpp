@@ -24,6 +24,7 @@
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/io/open_source.hpp"
 #include "resoct/io/overview_hints.hpp"
+#include "resoct/render/frame_accumulator.hpp"
 #include "resoct/render/renderer.hpp"
 #include "resoct/scene/overview_scene.hpp"
 #include "resoct/scene/scene.hpp"
@@ -33,6 +34,7 @@
 #include "support/source_options.hpp"
 #include "support/tool_main.hpp"
 #include "viewer/view_controls.hpp"
+#include "viewer/text_panel.hpp"
 #include "viewer/view_script.hpp"
 #include "viewer/vk_window.hpp"
 
@@ -57,6 +59,9 @@ struct Args {
   bool verbose = false;
   std::uint64_t cache_mb = 512;
   std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
+  std::uint32_t accumulate = 16;  // frames averaged for a still view; <= 1: none
+  bool half_res_moving = false;
+  bool no_panel = false;
 };
 
 /// "WxH" with each 1..16384.
@@ -97,10 +102,14 @@ struct Input {
   double last_x = 0, last_y = 0;
 };
 
-const char* key_name(int key) {
+const char* key_name(int key, int mods) {
   static const char* digits[] = {"1", "2", "3", "4", "5", "6", "7", "8", "9"};
   if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) return digits[key - GLFW_KEY_1];
   switch (key) {
+    case GLFW_KEY_T: return (mods & GLFW_MOD_SHIFT) != 0 ? "T" : "t";
+    case GLFW_KEY_PAGE_UP: return "pageup";
+    case GLFW_KEY_PAGE_DOWN: return "pagedown";
+    case GLFW_KEY_F1: return "f1";
     case GLFW_KEY_TAB: return "tab";
     case GLFW_KEY_P: return "p";
     case GLFW_KEY_C: return "c";
@@ -123,10 +132,10 @@ const char* key_name(int key) {
 
 void install_callbacks(GLFWwindow* w, Input* input) {
   glfwSetWindowUserPointer(w, input);
-  glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int) {
+  glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) {
     auto* in = static_cast<Input*>(glfwGetWindowUserPointer(win));
     if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
-    if (const char* name = key_name(key)) in->keys.emplace_back(name);
+    if (const char* name = key_name(key, mods)) in->keys.emplace_back(name);
   });
   glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int button, int action, int mods) {
     auto* in = static_cast<Input*>(glfwGetWindowUserPointer(win));
@@ -183,6 +192,7 @@ int run(const Args& a) {
     throw invalid_parameter("backend", "expected cpu or vulkan, got '" + a.backend + "'");
   }
   const RenderMode initial_mode = parse_render_mode(a.mode);
+  if (a.accumulate > 4096) throw invalid_parameter("accumulate", "must be 0..4096");
   if (a.cache_mb == 0 || a.cache_mb > (std::uint64_t(1) << 24)) {
     throw invalid_parameter("cache-mb", "must be 1..2^24");
   }
@@ -195,7 +205,8 @@ int run(const Args& a) {
   if (!a.script.empty()) script = load_view_script(a.script);
   if (!a.screenshot.empty()) tools::check_output_path("screenshot", a.screenshot);
   for (const ScriptCommand& c : script) {
-    if (c.kind == ScriptCommand::Kind::screenshot || c.kind == ScriptCommand::Kind::save_scene) {
+    if (c.kind == ScriptCommand::Kind::screenshot || c.kind == ScriptCommand::Kind::save_scene ||
+        c.kind == ScriptCommand::Kind::window_screenshot) {
       try {
         tools::check_output_path(c.where, c.text);
       } catch (const Error& e) {
@@ -210,6 +221,8 @@ int run(const Args& a) {
   Scene initial =
       from_file ? *from_file : overview_scene(volume, window_size, overview_hints(*source));
   initial.viewport = window_size;
+  // A time series shows its timepoint explicitly, so that 't' / 'T' step from it.
+  if (source->timepoints() > 1 && !initial.timepoint) initial.timepoint = source->timepoint();
   initial.validate(volume, source->timepoints(), a.scene.empty() ? "scene" : a.scene);
 
   GlfwSession glfw;
@@ -248,7 +261,14 @@ int run(const Args& a) {
   std::fprintf(stderr, "resoct-view: %s on %s (%s backend)\n", source->name().c_str(),
                vk.device_name().c_str(), a.backend.c_str());
 
-  ViewControls controls(initial, initial_mode);
+  ViewControls controls(initial, initial_mode, source->timepoints());
+  // Still views average jittered frames (docs/viewer.md "Jittered accumulation").
+  FrameAccumulator acc(std::max(a.accumulate, 1u));
+  const bool accumulating = a.accumulate > 1;
+  bool shown_accumulated = false;  // the window shows acc.image(), not the last frame
+  bool last_plain_full = false;    // the last frame: unjittered, full resolution
+  bool panel_on = !a.no_panel;
+  std::string panel_state;
   FrameReport report;
   std::optional<Scene> shown;  // the scene of the last frame
   RenderMode shown_mode = initial_mode;
@@ -274,13 +294,28 @@ int run(const Args& a) {
     }
     return img;
   };
+  // What the window shows without the panel: the average while accumulating, else the frame.
+  const auto shown_image = [&]() -> Image {
+    return shown_accumulated ? acc.image() : frame_image();
+  };
   const auto screenshot = [&](const std::string& path) {
-    write_png(frame_image(), path);
+    write_png(shown_image(), path);
+    std::fprintf(stderr, "resoct-view: wrote %s\n", path.c_str());
+  };
+  std::vector<std::string> panel_lines;
+  const auto window_screenshot = [&](const std::string& path) {
+    Image img = shown_image();
+    if (panel_on) composite_panel(img, draw_panel(panel_lines));
+    write_png(img, path);
     std::fprintf(stderr, "resoct-view: wrote %s\n", path.c_str());
   };
   const auto on_key = [&](const std::string& key) {
     const KeyAction act = controls.press(key);
     if (act == KeyAction::quit) quit = true;
+    if (act == KeyAction::toggle_panel) {
+      panel_on = !panel_on;
+      if (!panel_on) vk.set_panel(nullptr, 0, 0);
+    }
     if (act == KeyAction::screenshot) {
       char name[64];
       std::snprintf(name, sizeof name, "resoct-view-%04u.png", screenshot_counter++);
@@ -290,6 +325,13 @@ int run(const Args& a) {
   // Whether the last frame shows the current scene in the current mode.
   const auto up_to_date = [&] {
     return shown && *shown == controls.scene() && shown_mode == controls.mode();
+  };
+  std::uint32_t accumulate_budget = 0;
+  const ScriptCommand* accumulate_cmd = nullptr;
+  // The still view is averaged as far as it goes (or accumulation is off).
+  const auto accumulated = [&] {
+    return !accumulating ||
+           (up_to_date() && converged && acc.accumulating(controls.scene()) && acc.done());
   };
 
   while (!quit) {
@@ -307,10 +349,14 @@ int run(const Args& a) {
 
     // Script commands run until one waits for frames; a screenshot or save-scene first waits for
     // a frame of the current scene.
-    while (!quit && wait_frames == 0 && converge_cmd == nullptr && pc < script.size()) {
+    while (!quit && wait_frames == 0 && converge_cmd == nullptr && accumulate_cmd == nullptr &&
+           pc < script.size()) {
       const ScriptCommand& c = script[pc];
       using K = ScriptCommand::Kind;
-      if ((c.kind == K::screenshot || c.kind == K::save_scene) && !up_to_date()) break;
+      if ((c.kind == K::screenshot || c.kind == K::save_scene || c.kind == K::window_screenshot) &&
+          !up_to_date()) {
+        break;
+      }
       ++pc;
       switch (c.kind) {
         case K::orbit: controls.orbit(c.x, c.y); break;
@@ -324,7 +370,14 @@ int run(const Args& a) {
             converge_budget = c.count;
           }
           break;
+        case K::wait_accumulated:
+          if (!accumulated()) {
+            accumulate_cmd = &c;
+            accumulate_budget = c.count;
+          }
+          break;
         case K::screenshot: screenshot(c.text); break;
+        case K::window_screenshot: window_screenshot(c.text); break;
         case K::save_scene: save_scene(controls.scene(), c.text); break;
         case K::quit: quit = true; break;
       }
@@ -343,11 +396,13 @@ int run(const Args& a) {
       renderer.reset();
       renderer = make_renderer(controls.mode());
       shown.reset();
+      acc = FrameAccumulator(std::max(a.accumulate, 1u));  // the bricks load again
     }
     const bool changed = !up_to_date();
-    const bool scripted = wait_frames > 0 || converge_cmd != nullptr || pc < script.size();
+    const bool scripted = wait_frames > 0 || converge_cmd != nullptr || accumulate_cmd != nullptr ||
+                          pc < script.size();
     // --exit-after-frames renders its N frames even when nothing changes (measurements).
-    if (!changed && converged && wait_frames == 0 && a.exit_after_frames == 0) {
+    if (!changed && converged && accumulated() && wait_frames == 0 && a.exit_after_frames == 0) {
       // Converged and nothing to do: sleep until input arrives.
       if (!scripted) glfwWaitEventsTimeout(0.1);
       continue;
@@ -357,22 +412,84 @@ int run(const Args& a) {
       continue;
     }
     const auto t0 = Clock::now();
+    // Moving with --half-res-moving: a quarter of the pixels, scaled up by the presenter's blit.
+    const bool low_res = a.half_res_moving && changed;
+    // Standing still on a converged frame: the next frame of the running average. Frames
+    // rendered after it is complete (wait, --exit-after-frames) are plain and leave it shown.
+    const bool acc_done =
+        accumulating && !changed && acc.accumulating(controls.scene()) && acc.done();
+    const bool jittered = accumulating && !changed && converged && !low_res && !acc_done;
+    FrameJitter jitter;
+    if (jittered) {
+      jitter = acc.next(controls.scene());
+      if (jitter.none() && last_plain_full) {
+        // The average's first frame is the plain frame already shown: add it, render nothing.
+        acc.add(frame_image(), false);
+        shown_accumulated = true;
+        continue;
+      }
+    }
+    Scene scene = controls.scene();
+    if (low_res) {
+      scene.viewport = Viewport{std::max(1u, (scene.viewport.width + 1) / 2),
+                                std::max(1u, (scene.viewport.height + 1) / 2)};
+    }
     vk.wait_frame();  // the last copy to the screen may still read the frame's buffer
-    renderer->render_frame(controls.scene(), report);
-    if (report.device_image.handle != 0) {
+    renderer->render_frame(scene, report, jitter);
+    shown = controls.scene();
+    shown_mode = controls.mode();
+    // A low-resolution frame is never the still view's last word.
+    converged = report.converged && !low_res;
+    last_plain_full = !jittered && !low_res;
+    shown_accumulated = jittered || (acc_done && converged);
+    if (jittered) acc.add(frame_image(), report.stats.bricks_uploaded != 0);
+    ++frames;
+    const FrameStats& s = report.stats;
+    panel_state = changed     ? (low_res ? "moving, half resolution" : "moving")
+                  : converged ? "converged"
+                              : "refining";
+    if (accumulating && !changed && converged) {
+      panel_state +=
+          ", accumulated " + std::to_string(acc.frames()) + "/" + std::to_string(acc.max_frames());
+    }
+    if (panel_on) {
+      char l0[96], l1[96], l2[96];
+      std::snprintf(l0, sizeof l0, "frame %llu  %ux%u  %.1f ms",
+                    static_cast<unsigned long long>(frames), report.width, report.height,
+                    s.ms_frame);
+      std::snprintf(l1, sizeof l1, "bricks: requested %llu  loaded %llu",
+                    static_cast<unsigned long long>(s.brick_requests),
+                    static_cast<unsigned long long>(s.bricks_uploaded));
+      std::snprintf(l2, sizeof l2, "resident %u  in flight %llu", s.resident_bricks,
+                    static_cast<unsigned long long>(s.loads_in_flight + s.loads_queued));
+      panel_lines = {l0, l1, l2, panel_state};
+      if (renderer->timepoints() > 1) {
+        panel_lines.push_back("timepoint " + std::to_string(renderer->timepoint()) + " of " +
+                              std::to_string(renderer->timepoints()));
+      }
+      const Image panel = draw_panel(panel_lines);
+      vk.set_panel(panel.pixels().data(), panel.width(), panel.height());
+    }
+    if (shown_accumulated) {
+      vk.present_host(acc.image().pixels().data(), acc.image().width(), acc.image().height());
+    } else if (report.device_image.handle != 0) {
       vk.present_device(vk::buffer_of(report.device_image), report.device_image.offset,
                         report.width, report.height);
     } else {
       vk.present_host(report.image.pixels().data(), report.image.width(), report.image.height());
     }
     const double loop_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    shown = controls.scene();
-    shown_mode = controls.mode();
-    converged = report.converged;
-    ++frames;
-    const FrameStats& s = report.stats;
     (changed ? moving : refining).add(s.ms_frame, loop_ms);
     if (wait_frames > 0) --wait_frames;
+    if (accumulate_cmd != nullptr) {
+      if (accumulated()) {
+        accumulate_cmd = nullptr;
+      } else if (--accumulate_budget == 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    accumulate_cmd->where + ": wait-accumulated: not accumulated after " +
+                        std::to_string(accumulate_cmd->count) + " frames");
+      }
+    }
     if (converge_cmd != nullptr) {
       if (converged) {
         converge_cmd = nullptr;
@@ -382,14 +499,20 @@ int run(const Args& a) {
                         std::to_string(converge_cmd->count) + " frames");
       }
     }
-    const char* state = changed ? (converged ? "moving, converged" : "moving")
+    std::string state = changed ? (converged ? "moving, converged" : "moving")
                                 : (converged ? "refining, converged" : "refining");
+    if (low_res) state += ", half resolution";
+    if (jittered) {
+      state +=
+          ", accumulated " + std::to_string(acc.frames()) + "/" + std::to_string(acc.max_frames());
+    }
     char line[256];
     std::snprintf(line, sizeof line,
                   "%.1f ms | requested %llu, loaded %llu, resident %u, in flight %llu | %s",
                   s.ms_frame, static_cast<unsigned long long>(s.brick_requests),
                   static_cast<unsigned long long>(s.bricks_uploaded), s.resident_bricks,
-                  static_cast<unsigned long long>(s.loads_in_flight + s.loads_queued), state);
+                  static_cast<unsigned long long>(s.loads_in_flight + s.loads_queued),
+                  state.c_str());
     if (a.verbose) {
       std::fprintf(stderr, "resoct-view: frame %llu %ux%u: %s, %.1f ms with present\n",
                    static_cast<unsigned long long>(frames), report.width, report.height, line,
@@ -443,6 +566,12 @@ int main(int argc, char** argv) {
   app.add_option("--exit-after-frames", a.exit_after_frames,
                  "render N frames, rendering on after convergence, then quit (0 = never)");
   app.add_flag("--verbose", a.verbose, "print every frame's statistics");
+  app.add_option("--accumulate", a.accumulate,
+                 "jittered frames averaged while the view stands still (0 or 1: none; <= 4096)")
+      ->capture_default_str();
+  app.add_flag("--half-res-moving", a.half_res_moving,
+               "render at half the window's resolution while the scene changes");
+  app.add_flag("--no-panel", a.no_panel, "start with the statistics panel off (F1 toggles it)");
   app.add_option("--cache-mb", a.cache_mb, "device brick cache in MiB")->capture_default_str();
   app.add_option("--threads", a.threads, "loader threads (0 = load synchronously)")
       ->capture_default_str();

@@ -14,9 +14,9 @@ namespace resoct::view {
 
 namespace {
 
-constexpr const char* kKeys[] = {"1",   "2", "3", "4", "5", "6", "7",     "8", "9",
-                                 "tab", "p", "c", "r", "[", "]", ",",     ".", "m",
-                                 "s",   "h", "i", "o", "x", "q", "escape"};
+constexpr const char* kKeys[] = {
+    "1", "2", "3", "4", "5", "6", "7", "8", "9", "tab",    "p", "c", "r",      "[",        "]",
+    ",", ".", "m", "s", "h", "i", "o", "x", "q", "escape", "t", "T", "pageup", "pagedown", "f1"};
 
 // Rotates v about the unit axis by `rad` (Rodrigues).
 glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& axis, double rad) {
@@ -56,8 +56,8 @@ std::string key_names() {
   return s;
 }
 
-ViewControls::ViewControls(const Scene& initial, RenderMode mode)
-    : initial_(initial), scene_(initial), mode_(mode) {
+ViewControls::ViewControls(const Scene& initial, RenderMode mode, std::uint32_t timepoints)
+    : initial_(initial), scene_(initial), mode_(mode), timepoints_(std::max(timepoints, 1u)) {
   for (const ChannelSettings& c : initial.channels) channels_.push_back(Channel{c});
   rebuild();
 }
@@ -179,6 +179,15 @@ KeyAction ViewControls::press(const std::string& key) {
     } else {
       c.projection = Projection::perspective;
     }
+  } else if (key == "t" || key == "T" || key == "pageup" || key == "pagedown") {
+    // Time series: the next (t, page down) or previous (T, page up) timepoint, wrapping.
+    const std::uint32_t now = scene_.timepoint.value_or(0);
+    const bool forward = key == "t" || key == "pagedown";
+    if (timepoints_ > 1) {
+      scene_.timepoint = forward ? (now + 1) % timepoints_ : (now + timepoints_ - 1) % timepoints_;
+    }
+  } else if (key == "f1") {
+    return KeyAction::toggle_panel;
   } else if (key == "x") {
     return KeyAction::screenshot;
   } else if (key == "q" || key == "escape") {
@@ -255,6 +264,10 @@ std::string ViewControls::status() const {
   for (Effect e : scene_.effects) s += std::string(", ") + to_string(e);
   if (scene_.preintegration) s += ", preintegrated";
   if (scene_.camera.projection == Projection::orthographic) s += ", orthographic";
+  if (timepoints_ > 1) {
+    s += " | t " + std::to_string(scene_.timepoint.value_or(0)) + "/" +
+         std::to_string(timepoints_ - 1);
+  }
   return s;
 }
 

@@ -4,6 +4,7 @@
 // No window code: the GLFW callbacks and the --script commands both drive this class.
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,7 @@ bool is_key_name(const std::string& name);
 std::string key_names();
 
 /// What a key press asks of the application beyond changing the scene.
-enum class KeyAction { none, screenshot, quit };
+enum class KeyAction { none, screenshot, quit, toggle_panel };
 
 /// Transfer-function presets and colour maps the 'p' and 'c' keys cycle through per channel.
 inline constexpr const char* kPresetNames[] = {"scene", "ramp", "steep", "soft", "band"};
@@ -28,7 +29,8 @@ inline constexpr const char* kColourNames[] = {"scene", "white",   "red",    "gr
 class ViewControls {
  public:
   /// `initial` is what 'r' returns the camera to; its channels are those 1-9 toggle.
-  ViewControls(const Scene& initial, RenderMode mode);
+  /// `timepoints`: the source's (BrickSource::timepoints()), which 't' / 'T' step through.
+  ViewControls(const Scene& initial, RenderMode mode, std::uint32_t timepoints = 1);
 
   /// The scene to render now.
   const Scene& scene() const noexcept { return scene_; }
@@ -62,6 +64,7 @@ class ViewControls {
   Scene initial_;
   Scene scene_;
   RenderMode mode_;
+  std::uint32_t timepoints_ = 1;
   std::vector<Channel> channels_;
   std::size_t selected_ = 0;
 };

@@ -85,6 +85,14 @@ std::vector<ScriptCommand> parse_view_script(const std::string& text, const std:
       args(0, 1, "wait-converged [MAX_FRAMES]");
       c.kind = ScriptCommand::Kind::wait_converged;
       c.count = w.size() == 2 ? count(w[1], c.where, "wait-converged") : kDefaultConvergeFrames;
+    } else if (cmd == "wait-accumulated") {
+      args(0, 1, "wait-accumulated [MAX_FRAMES]");
+      c.kind = ScriptCommand::Kind::wait_accumulated;
+      c.count = w.size() == 2 ? count(w[1], c.where, "wait-accumulated") : kDefaultConvergeFrames;
+    } else if (cmd == "window-screenshot") {
+      args(1, 1, "window-screenshot PATH.png");
+      c.kind = ScriptCommand::Kind::window_screenshot;
+      c.text = w[1];
     } else if (cmd == "screenshot" || cmd == "save-scene") {
       args(1, 1, cmd == "screenshot" ? "screenshot PATH.png" : "save-scene PATH.json");
       c.kind =
@@ -96,8 +104,8 @@ std::vector<ScriptCommand> parse_view_script(const std::string& text, const std:
     } else {
       throw Error(ErrorCode::invalid_argument,
                   c.where + ": unknown command '" + cmd +
-                      "' (orbit, zoom, pan, key, wait, wait-converged, screenshot, save-scene, "
-                      "quit)");
+                      "' (orbit, zoom, pan, key, wait, wait-converged, wait-accumulated, "
+                      "screenshot, window-screenshot, save-scene, quit)");
     }
     out.push_back(std::move(c));
   }

@@ -17,9 +17,11 @@ struct ScriptCommand {
     key,             ///< key NAME: as if the key was pressed (docs/viewer.md "Keys")
     wait,            ///< wait N: render N frames
     wait_converged,  ///< wait-converged [MAX]: render until a frame is converged (at most MAX)
-    screenshot,      ///< screenshot PATH: the last frame as PNG
-    save_scene,      ///< save-scene PATH: the current scene as JSON (docs/scene.md)
-    quit,            ///< quit: end the viewer
+    wait_accumulated,   ///< wait-accumulated [MAX]: render until the still view is accumulated
+    window_screenshot,  ///< window-screenshot PATH: the frame as shown, panel included
+    screenshot,         ///< screenshot PATH: the last frame as PNG
+    save_scene,         ///< save-scene PATH: the current scene as JSON (docs/scene.md)
+    quit,               ///< quit: end the viewer
   };
   Kind kind = Kind::wait;
   double x = 0.0;

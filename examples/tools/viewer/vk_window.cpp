@@ -11,6 +11,7 @@
 #include <mutex>
 
 #include "resoct/base/error.hpp"
+#include "viewer/text_panel.hpp"
 
 namespace resoct::view {
 
@@ -97,6 +98,15 @@ struct VkWindow::Impl {
   HostBuffer staging;   // CPU backend frames
   HostBuffer readback;  // screenshots
 
+  // The on-screen panel (text_panel.hpp): host pixels, copied at each present into a float image
+  // of its own and blitted 1:1 over the top-left corner of the swapchain image.
+  std::vector<glm::vec4> panel;
+  std::uint32_t panel_w = 0, panel_h = 0;
+  HostBuffer panel_staging;
+  VkImage panel_image = VK_NULL_HANDLE;
+  VkDeviceMemory panel_memory = VK_NULL_HANDLE;
+  std::uint32_t panel_image_w = 0, panel_image_h = 0;
+
   std::atomic<std::uint64_t> messages{0};
   mutable std::mutex log_mutex;
   std::vector<std::string> log;
@@ -149,8 +159,16 @@ struct VkWindow::Impl {
   }
 
   void ensure_frame_image(std::uint32_t w, std::uint32_t h) {
-    if (frame != VK_NULL_HANDLE && frame_w == w && frame_h == h) return;
-    destroy_frame_image();
+    ensure_image(frame, frame_memory, frame_w, frame_h, w, h);
+  }
+
+  // A float RGBA image that is a copy destination and a blit source, (re)made at w x h.
+  void ensure_image(VkImage& image, VkDeviceMemory& memory, std::uint32_t& iw, std::uint32_t& ih,
+                    std::uint32_t w, std::uint32_t h) {
+    if (image != VK_NULL_HANDLE && iw == w && ih == h) return;
+    destroy_image(image, memory, iw, ih);
+    VkImage& frame = image;
+    VkDeviceMemory& frame_memory = memory;
     VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ici.imageType = VK_IMAGE_TYPE_2D;
     ici.format = kFrameFormat;
@@ -169,16 +187,59 @@ struct VkWindow::Impl {
     mai.memoryTypeIndex = memory_type(req.memoryTypeBits, 0);
     check(vkAllocateMemory(device, &mai, nullptr, &frame_memory), "vkAllocateMemory");
     check(vkBindImageMemory(device, frame, frame_memory, 0), "vkBindImageMemory");
-    frame_w = w;
-    frame_h = h;
+    iw = w;
+    ih = h;
+  }
+
+  void destroy_image(VkImage& image, VkDeviceMemory& memory, std::uint32_t& w, std::uint32_t& h) {
+    if (image != VK_NULL_HANDLE) vkDestroyImage(device, image, nullptr);
+    if (memory != VK_NULL_HANDLE) vkFreeMemory(device, memory, nullptr);
+    image = VK_NULL_HANDLE;
+    memory = VK_NULL_HANDLE;
+    w = h = 0;
   }
 
   void destroy_frame_image() {
-    if (frame != VK_NULL_HANDLE) vkDestroyImage(device, frame, nullptr);
-    if (frame_memory != VK_NULL_HANDLE) vkFreeMemory(device, frame_memory, nullptr);
-    frame = VK_NULL_HANDLE;
-    frame_memory = VK_NULL_HANDLE;
-    frame_w = frame_h = 0;
+    destroy_image(frame, frame_memory, frame_w, frame_h);
+    destroy_image(panel_image, panel_memory, panel_image_w, panel_image_h);
+  }
+
+  // Records the panel's copy into the swapchain image (in TRANSFER_DST layout, just written by
+  // the frame's blit).
+  void record_panel(VkImage target) {
+    const std::uint32_t m = kPanelMargin;
+    if (panel_w == 0 || extent.width <= m || extent.height <= m) return;
+    const std::uint32_t w = std::min(panel_w, extent.width - m);
+    const std::uint32_t h = std::min(panel_h, extent.height - m);
+    const VkDeviceSize bytes = VkDeviceSize(panel_w) * panel_h * sizeof(glm::vec4);
+    ensure_host_buffer(panel_staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    std::memcpy(panel_staging.mapped, panel.data(), std::size_t(bytes));
+    ensure_image(panel_image, panel_memory, panel_image_w, panel_image_h, panel_w, panel_h);
+    image_barrier(cmd, panel_image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_ACCESS_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {panel_w, panel_h, 1};
+    vkCmdCopyBufferToImage(cmd, panel_staging.buffer, panel_image,
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    image_barrier(cmd, panel_image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_ACCESS_TRANSFER_READ_BIT);
+    // The frame's blit wrote the swapchain image: this blit writes it again after it.
+    image_barrier(cmd, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_ACCESS_TRANSFER_WRITE_BIT);
+    VkImageBlit blit{};
+    blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    blit.srcOffsets[1] = {std::int32_t(w), std::int32_t(h), 1};
+    blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    blit.dstOffsets[0] = {std::int32_t(m), std::int32_t(m), 0};
+    blit.dstOffsets[1] = {std::int32_t(m + w), std::int32_t(m + h), 1};
+    vkCmdBlitImage(cmd, panel_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
   }
 
   void destroy_semaphores() {
@@ -367,6 +428,7 @@ struct VkWindow::Impl {
     vkCmdBlitImage(cmd, frame, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images[index],
                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit,
                    !same && linear_blit ? VK_FILTER_LINEAR : VK_FILTER_NEAREST);
+    record_panel(images[index]);
     image_barrier(cmd, images[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                   VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_TRANSFER_BIT,
                   VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0);
@@ -543,6 +605,7 @@ VkWindow::~VkWindow() {
     d.destroy_frame_image();
     d.destroy_host_buffer(d.staging);
     d.destroy_host_buffer(d.readback);
+    d.destroy_host_buffer(d.panel_staging);
     d.destroy_semaphores();
     if (d.swapchain != VK_NULL_HANDLE) vkDestroySwapchainKHR(d.device, d.swapchain, nullptr);
     if (d.fence != VK_NULL_HANDLE) vkDestroyFence(d.device, d.fence, nullptr);
@@ -577,6 +640,13 @@ std::string VkWindow::device_name() const {
 void VkWindow::present_device(VkBuffer buffer, std::uint64_t offset, std::uint32_t width,
                               std::uint32_t height) {
   impl_->present(buffer, offset, width, height, true);
+}
+
+void VkWindow::set_panel(const glm::vec4* pixels, std::uint32_t width, std::uint32_t height) {
+  Impl& d = *impl_;
+  d.panel.assign(pixels, pixels + std::size_t(width) * height);
+  d.panel_w = pixels == nullptr ? 0 : width;
+  d.panel_h = pixels == nullptr ? 0 : height;
 }
 
 void VkWindow::present_host(const glm::vec4* pixels, std::uint32_t width, std::uint32_t height) {

@@ -43,6 +43,9 @@ class VkWindow {
                       std::uint32_t height);
   /// Shows a frame in host memory (width * height float RGBA pixels).
   void present_host(const glm::vec4* pixels, std::uint32_t width, std::uint32_t height);
+  /// The panel (text_panel.hpp) every later present copies 1:1 over the window's top-left
+  /// corner at kPanelMargin, whatever the frame's size; nullptr = no panel.
+  void set_panel(const glm::vec4* pixels, std::uint32_t width, std::uint32_t height);
   /// Copies a device frame back to the host (screenshots).
   std::vector<glm::vec4> read_device(VkBuffer buffer, std::uint64_t offset, std::uint32_t width,
                                      std::uint32_t height);

@@ -16,9 +16,12 @@ namespace resoct {
 /// The hints `source` offers, per dataset channel:
 ///  - an OME-Zarr image (OmeZarrSource) with `omero.channels`: each channel's `color` and
 ///    `window` (docs/formats.md);
-///  - no other reader exposes display metadata or a value histogram today, so their hints are
-///    empty and overview_scene falls back to ramps over the value ranges.
-/// Never throws for odd metadata: an unreadable colour is left out. Thread-safety: a pure
+///  - every channel the overview shows (the first kOverviewChannels) that has no window gets a
+///    histogram of its values at the coarsest pyramid level (coarse_value_histogram: one brick
+///    per channel, read here), so that overview_scene ramps from its 50th to its 99.5th
+///    percentile. No reader's metadata carries a histogram.
+/// Never throws for odd metadata: an unreadable colour is left out, a brick that cannot be read
+/// leaves the histogram empty (the ramp over the value range). Thread-safety: a pure
 /// function of the source.
 OverviewHints overview_hints(const BrickSource& source);
 

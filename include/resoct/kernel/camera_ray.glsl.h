@@ -4,7 +4,8 @@
 // resoct::CameraRays does in double: image-plane coordinates u = (2x − width) / height · hh and
 // v = (height − 2y) / height · hh with hh = half_height. Perspective rays start at the eye with
 // direction normalize(forward + u·right + v·up); orthographic rays start at eye + u·right + v·up
-// with direction forward.
+// with direction forward. An accumulated frame moves the centre by its sub-pixel jitter
+// (jitter_x, jitter_y); without one they are 0, and px + 0.5 + 0 is exactly px + 0.5.
 //
 // The voxel-space origin is the exact eye cell (host-split in double) plus a float fraction; the
 // orthographic offset u·right + v·up is added to the fraction and re-split, so its rounding is
@@ -28,8 +29,8 @@ RESOCT_FN vec3 resoct_frame_voxels_per_box(ResoctFrame f) {
 RESOCT_FN void resoct_camera_ray(ResoctFrame f, uint px, uint py, RESOCT_OUT(vec3) dir_box,
                                  RESOCT_OUT(ivec3) origin_cell, RESOCT_OUT(vec3) origin_frac) {
   float rows = float(f.height);
-  float u = (2.0f * (float(px) + 0.5f) - float(f.width)) / rows * f.half_height;
-  float v = (rows - 2.0f * (float(py) + 0.5f)) / rows * f.half_height;
+  float u = (2.0f * (float(px) + 0.5f + f.jitter_x) - float(f.width)) / rows * f.half_height;
+  float v = (rows - 2.0f * (float(py) + 0.5f + f.jitter_y)) / rows * f.half_height;
   vec3 fw = vec3(f.forward_x, f.forward_y, f.forward_z);
   vec3 rt = vec3(f.right_x, f.right_y, f.right_z);
   vec3 up = vec3(f.up_x, f.up_y, f.up_z);

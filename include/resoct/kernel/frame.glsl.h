@@ -128,6 +128,12 @@ struct ResoctFrame {
   // Row i (at 3i): lens axis i / (voxels_per_box * half size i), so that a voxel-space offset
   // from the centre maps to lens coordinates, the lens being [-1, 1]^3.
   float lens_matrix[9];
+
+  // Jitter for accumulating frames (docs/rendering.md "Jittered accumulation"); all 0 = none, and
+  // then the image is bit-identical to a frame without jitter. Last, so that no other offset moves.
+  float jitter_x;       // sub-pixel offset of every pixel's ray, pixels, in [-0.5, 0.5)
+  float jitter_y;       //   (x to the right, y down, like pixel rows)
+  float jitter_sample;  // shift of the march's samples along the ray, steps, in [-0.5, 0.5)
 };
 
 // Effect constants of a frame (kernel/effects.glsl.h; docs/rendering.md "Effects"), a record of

@@ -151,6 +151,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
     resoct_preint_ray_clear(pr);
   }
   float t_enter = t;
+  // Jittered accumulation: every sample moves by jitter_sample steps (t + 0 * dt == t).
+  t = t + f.jitter_sample * dt;
 
   // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
   // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs

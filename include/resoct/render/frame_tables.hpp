@@ -11,6 +11,7 @@
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/engine/octree_layout.hpp"
 #include "resoct/engine/request_set.hpp"
+#include "resoct/render/frame_jitter.hpp"
 #include "resoct/scene/scene.hpp"
 
 namespace resoct {
@@ -24,6 +25,8 @@ struct FrameOptions {
   std::uint32_t start_depth = 0;
   /// Hard cap of march iterations per ray (>= 1); hits are counted, never expected.
   std::uint32_t max_iterations = 1u << 22;
+  /// Sub-pixel and sample offsets of an accumulated frame (none by default).
+  FrameJitter jitter;
 };
 
 /// Fills FrameTables for one frame. Slots are ordered by scene importance (ascending, as the
@@ -33,8 +36,9 @@ struct FrameOptions {
 /// Throws Error(invalid_argument) naming the parameter when the scene does not fit the volume
 /// ("scene"), a channel is not mapped ("channels"), more than RESOCT_MAX_SLOTS channels are
 /// visible ("scene.channels"), the layout does not match the hierarchy ("layout"), an extent or
-/// node extent does not fit 31 bits ("extent", "layout"), or max_iterations is 0
-/// ("max_iterations"). Thread-safe (pure function of its arguments).
+/// node extent does not fit 31 bits ("extent", "layout"), max_iterations is 0
+/// ("max_iterations") or the jitter is out of range ("jitter.*", FrameJitter::validate).
+/// Thread-safe (pure function of its arguments).
 FrameTables build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
                                const OctreeLayout& layout, const ChannelMap& channels,
                                const FrameOptions& options = {});

@@ -16,6 +16,7 @@
 #include "resoct/backend/backend.hpp"
 #include "resoct/backend/image.hpp"
 #include "resoct/engine/load_failure.hpp"
+#include "resoct/render/frame_jitter.hpp"
 #include "resoct/render/frame_stats.hpp"
 #include "resoct/render/renderer_options.hpp"
 #include "resoct/scene/scene.hpp"
@@ -89,6 +90,11 @@ class Renderer {
   /// no frame allocates image memory. Every field of `report` is overwritten. Unchanged when the
   /// scene is rejected.
   void render_frame(const Scene& scene, FrameReport& report);
+  /// The same with every ray moved by `jitter` (sub-pixel offset, sample shift), for averaging
+  /// frames of an unchanged view (FrameAccumulator, docs/rendering.md "Jittered accumulation").
+  /// A zero jitter renders exactly the frame above. Throws Error(invalid_argument) naming
+  /// "jitter.*" when it is out of range (FrameJitter::validate); `report` is then unchanged.
+  void render_frame(const Scene& scene, FrameReport& report, const FrameJitter& jitter);
   /// Renders until a frame reports converged or `max_frames` frames were rendered (>= 1).
   ConvergeReport render_until_converged(const Scene& scene, std::uint32_t max_frames = 1000);
 

@@ -1,8 +1,18 @@
 #include "resoct/io/overview_hints.hpp"
 
+#include <algorithm>
+
+#include "resoct/base/error.hpp"
 #include "resoct/io/formats/ome_zarr.hpp"
+#include "resoct/sources/value_histogram.hpp"
 
 namespace resoct {
+
+namespace {
+// Bins of the coarse histogram: the percentile is linear within a bin, so 1024 bins place it
+// within 0.1 % of the value range.
+constexpr std::uint32_t kOverviewHistogramBins = 1024;
+}  // namespace
 
 std::optional<glm::dvec3> parse_hex_colour(std::string_view text) noexcept {
   if (!text.empty() && text.front() == '#') text.remove_prefix(1);
@@ -32,6 +42,19 @@ OverviewHints overview_hints(const BrickSource& source) {
       h.colour = parse_hex_colour(omero[c].color);
       h.window = omero[c].window;
       hints.channels.push_back(h);
+    }
+  }
+  // Without a window, the channels the overview shows get a histogram of their coarsest level
+  // (one brick each), whose percentiles overview_scene turns into the ramp.
+  const std::uint32_t shown = std::min(source.volume().channels, kOverviewChannels);
+  if (hints.channels.size() < shown) hints.channels.resize(shown);
+  for (std::uint32_t c = 0; c < shown; ++c) {
+    if (!hints.channels[c].window) {
+      try {
+        hints.channels[c].histogram = coarse_value_histogram(source, c, kOverviewHistogramBins);
+      } catch (const Error&) {
+        // An unreadable brick leaves the default ramp; rendering reports the failure itself.
+      }
     }
   }
   return hints;

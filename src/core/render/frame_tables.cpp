@@ -214,6 +214,7 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     throw invalid_parameter("layout", "octree extent differs from the volume extent");
   }
   if (options.max_iterations == 0) throw invalid_parameter("max_iterations", "must be >= 1");
+  options.jitter.validate();
   if (scene.channels.size() > kernel::RESOCT_MAX_SLOTS) {
     throw invalid_parameter(
         "scene.channels",
@@ -237,6 +238,9 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   f.node_slot_count = channels.slot_count();
   f.request_greedy = options.request_strategy == RequestStrategy::greedy ? 1u : 0u;
   fill_camera(scene, hierarchy, f);
+  f.jitter_x = options.jitter.pixel_x;
+  f.jitter_y = options.jitter.pixel_y;
+  f.jitter_sample = options.jitter.sample;
   out.fx = kernel::ResoctFxFrame{};
   fill_effects(scene, hierarchy, out.fx);
 

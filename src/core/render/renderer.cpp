@@ -387,8 +387,9 @@ void Renderer::Impl::report_failures(FrameReport& report) {
   }
 }
 
-const FrameTables& Renderer::Impl::frame_tables(const Scene& scene) {
+const FrameTables& Renderer::Impl::frame_tables(const Scene& scene, const FrameJitter& jitter) {
   FrameOptions fo;
+  fo.jitter = jitter;
   fo.mode = options_.mode;
   fo.frame_index = std::uint32_t(frame_);
   fo.request_strategy = options_.strategy;
@@ -436,12 +437,18 @@ void Renderer::Impl::take_pixels(FrameReport& report) {
 }
 
 void Renderer::render_frame(const Scene& scene, FrameReport& report) {
-  impl_->render_frame(scene, report);
+  impl_->render_frame(scene, report, FrameJitter{});
 }
 
-void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report) {
+void Renderer::render_frame(const Scene& scene, FrameReport& report, const FrameJitter& jitter) {
+  impl_->render_frame(scene, report, jitter);
+}
+
+void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report,
+                                  const FrameJitter& jitter) {
   const auto t_frame = Clock::now();
   scene.validate(hierarchy_.volume(), timepoints(), "scene");
+  jitter.validate();
   if (scene.channels.size() > channels_.slot_count()) {
     throw invalid_parameter("scene", std::to_string(scene.channels.size()) +
                                          " channels exceed the renderer's " +
@@ -482,7 +489,7 @@ void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report) {
 
   t = Clock::now();
   const std::uint64_t epoch = channels_.epoch();
-  backend_->render(frame_tables(scene), result_);
+  backend_->render(frame_tables(scene, jitter), result_);
   stats.ms_render = ms_since(t);
   stats.backend = result_.stats;
 

@@ -45,9 +45,9 @@ struct Renderer::Impl {
        RendererOptions options);
 
   std::uint32_t timepoints() const noexcept { return source_->timepoints(); }
-  void render_frame(const Scene& scene, FrameReport& report);
+  void render_frame(const Scene& scene, FrameReport& report, const FrameJitter& jitter);
 
-  const FrameTables& frame_tables(const Scene& scene);
+  const FrameTables& frame_tables(const Scene& scene, const FrameJitter& jitter);
   void take_pixels(FrameReport& report);
   void assign_channels(const Scene& scene);
   void switch_timepoint(std::uint32_t t);

@@ -245,9 +245,15 @@ TEST(OmeZarr, OmeroColoursAndWindowsAreOverviewHints) {
   EXPECT_EQ(s.channels[0].tf.evaluate(0.0).a, 0.0);
   EXPECT_GT(s.channels[0].tf.evaluate(0.05).a, 0.0);
   EXPECT_EQ(s.channels[1].tf.evaluate(1.0), glm::dvec4(0.0, 1.0, 0.0, 0.5));
-  // Sources without display metadata give no hints.
-  EXPECT_TRUE(
-      overview_hints(*make_procedural_source("procedural:tubes:16x16x16:2", {})).channels.empty());
+  // Sources without display metadata give only the coarse histograms (test_value_histogram.cpp).
+  const OverviewHints plain =
+      overview_hints(*make_procedural_source("procedural:tubes:16x16x16:2", {}));
+  ASSERT_EQ(plain.channels.size(), 2u);
+  for (const ChannelDisplayHint& h : plain.channels) {
+    EXPECT_FALSE(h.window.has_value());
+    EXPECT_FALSE(h.colour.has_value());
+    EXPECT_FALSE(h.histogram.empty());
+  }
   EXPECT_EQ(parse_hex_colour("#ff8000"), glm::dvec3(1.0, 128.0 / 255.0, 0.0));
   EXPECT_FALSE(parse_hex_colour("12345").has_value());
   EXPECT_FALSE(parse_hex_colour("GG0000").has_value());
