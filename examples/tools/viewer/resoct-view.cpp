@@ -449,8 +449,9 @@ int run(const Args& a) {
                   : converged ? "converged"
                               : "refining";
     if (accumulating && !changed && converged) {
-      panel_state +=
-          ", accumulated " + std::to_string(acc.frames()) + "/" + std::to_string(acc.max_frames());
+      // A plain converged frame is the first of the average about to start.
+      const std::uint32_t n = acc.accumulating(controls.scene()) ? acc.frames() : 1;
+      panel_state += ", accumulated " + std::to_string(n) + "/" + std::to_string(acc.max_frames());
     }
     if (panel_on) {
       char l0[96], l1[96], l2[96];
