@@ -385,6 +385,10 @@ TEST(CpuTraverse, BackendRejectsBadUpdatesAndTables) {
   t.tf_luts.pop_back();
   FrameResult r;
   EXPECT_RESOCT_ERROR(b.render(t, r), ErrorCode::invalid_argument, "tables");
+  // A sample shift of more than half a step back would start the march outside the volume.
+  FrameTables j = rs.tables(s);
+  j.frame.jitter_sample = -0.75f;
+  EXPECT_RESOCT_ERROR(b.render(j, r), ErrorCode::invalid_argument, "jitter");
 }
 
 TEST(CpuTraverse, BackendRegistry) {

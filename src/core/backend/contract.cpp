@@ -29,6 +29,10 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
     fail("slot table size differs from slot_count");
   }
   if (f.slice_count > kernel::RESOCT_MAX_SLICES) fail("slice_count above RESOCT_MAX_SLICES");
+  // A sample shift below -1/2 step would put the first sample before the volume's entry.
+  for (float j : {f.jitter_x, f.jitter_y, f.jitter_sample}) {
+    if (!(j >= -0.5f && j < 0.5f)) fail("jitter outside [-0.5, 0.5)");
+  }
   if (t.levels.size() != f.level_count || f.level_count == 0 || f.level_count > 32) {
     fail("level table size differs from level_count");
   }
