@@ -58,14 +58,16 @@ inline float correct_opacity(float alpha, float ratio) {
   return std::clamp(one_minus_exp(ratio * log_one_minus(alpha)), 0.0f, 1.0f);
 }
 
-// Entry and exit of the half-open slab [lo, hi) along one axis (ray.glsl.h).
+// Entry and exit of the half-open slab [lo, hi) along one axis (ray.glsl.h): the ray's
+// reciprocal direction component, 0 where it is parallel, multiplies the plane distances.
 inline glm::vec2 slab(float origin, float dir, float lo, float hi) {
-  if (std::abs(dir) < kParallelEps) {
+  const float inv = std::abs(dir) < kParallelEps ? 0.0f : 1.0f / dir;
+  if (inv == 0.0f) {
     if (origin >= lo && origin < hi) return {-kTInf, kTInf};
     return {kTInf, -kTInf};
   }
-  const float t0 = (lo - origin) / dir;
-  const float t1 = (hi - origin) / dir;
+  const float t0 = (lo - origin) * inv;
+  const float t1 = (hi - origin) * inv;
   return {std::min(t0, t1), std::max(t0, t1)};
 }
 
@@ -189,7 +191,22 @@ template <class T>
     return acc.a >= ert;
   };
   // Whole steps [t, t + dt) while they fit, then the shorter last segment(s), corrected for
-  // their length (resoct_segment_length); resoct_advance_t keeps t strictly increasing.
+  // their length (resoct_segment_length). Step j starts at t_grid + j * dt, each operation
+  // rounded once (resoct_grid_t), at least one ulp past the previous start.
+  const float t_grid = t;
+  std::uint32_t j = 0;
+  const auto next_t = [&](float current) {
+    ++j;
+    const float jdt = float(j) * dt;
+    float next = t_grid + jdt;
+    if (next <= current) {
+      next = current + dt;
+      if (next <= current) {
+        next = current + std::max(std::abs(current) * kTUlpFactor, kTMinAdvance);
+      }
+    }
+    return next;
+  };
   bool saturated = false;
   while (t_exit - t >= dt) {
     ++n;
@@ -197,17 +214,13 @@ template <class T>
       saturated = true;
       break;
     }
-    float next = t + dt;
-    if (next <= t) next = t + std::max(std::abs(t) * kTUlpFactor, kTMinAdvance);
-    t = next;
+    t = next_t(t);
   }
   while (!saturated && t_exit - t > end_eps) {
     ++n;
     const float seg = std::max(std::min(dt, t_exit - t), 0.0f);
     if (sample(t + 0.5f * seg, seg / f.ref_step)) break;
-    float next = t + seg;
-    if (next <= t) next = t + std::max(std::abs(t) * kTUlpFactor, kTMinAdvance);
-    t = next;
+    t = next_t(t);
   }
   samples += n;
   visible += nv;

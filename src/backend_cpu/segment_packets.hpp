@@ -134,7 +134,8 @@ inline v4f load4(const glm::vec4& v) {
 [[gnu::noinline]] inline bool segment_samples_packets(const kernel::ResoctFrame& f,
                                                       const kernel::ResoctSource& src, float dt,
                                                       float t_exit, float seg_next, float seg,
-                                                      float tm, float& t, glm::vec4& acc,
+                                                      float tm, float t_grid, std::uint32_t& grid_j,
+                                                      float& t, glm::vec4& acc,
                                                       kernel::ResoctRayStats& stats) {
   using namespace kernel;
   const KernelContext& ctx = *t_ctx;
@@ -146,6 +147,7 @@ inline v4f load4(const glm::vec4& v) {
 
   v4f a = load4(acc);
   float t_now = t;
+  std::uint32_t j = grid_j;  // step index of t_now on the grid (kernel::resoct_grid_t)
   std::uint32_t samples = stats.samples;
   std::uint32_t accesses = stats.brick_accesses;
   std::uint32_t iterations = stats.iterations;
@@ -164,7 +166,7 @@ inline v4f load4(const glm::vec4& v) {
     bool ends = false;
     float t_after = 0.0f, next_seg = 0.0f, next_tm = 0.0f;
     for (;;) {
-      t_after = resoct_advance_t(lane_t[m - 1], lane_seg[m - 1]);
+      t_after = resoct_grid_t(t_grid, j + std::uint32_t(m), dt, lane_t[m - 1]);
       // The scalar loop counts one iteration per sample after the first.
       if (!(t_exit - t_after > eps_dt) || iterations + std::uint32_t(m - 1) >= f.max_iterations) {
         ends = true;
@@ -221,7 +223,9 @@ inline v4f load4(const glm::vec4& v) {
       if (nan[l] != 0) rgba[l] = splat(0.0f);
       alpha[l] = rgba[l][3];
     }
-    const v4f ratio = v4f{lane_seg[0], lane_seg[1], lane_seg[2], lane_seg[3]} / splat(f.ref_step);
+    // kernel::resoct_step_ratio per lane.
+    const v4f ratio =
+        v4f{lane_seg[0], lane_seg[1], lane_seg[2], lane_seg[3]} * splat(1.0f / f.ref_step);
     const v4f corrected = correct_opacity4(alpha, ratio);
 
     // Composite in order, as the scalar loop does.
@@ -238,6 +242,7 @@ inline v4f load4(const glm::vec4& v) {
       if (a[3] >= f.ert_opacity) {
         saturated = true;
         t_now = lane_t[l];
+        j = j + std::uint32_t(l);
         break;
       }
       marched = marched + lane_seg[l];
@@ -245,12 +250,14 @@ inline v4f load4(const glm::vec4& v) {
     }
     if (saturated) break;
     t_now = t_after;
+    j = j + std::uint32_t(m);
     if (ends) break;
     ++iterations;
     tm = next_tm;
     seg = next_seg;
   }
   t = t_now;
+  grid_j = j;
   std::memcpy(&acc, &a, sizeof(acc));
   stats.samples = samples;
   stats.brick_accesses = accesses;

@@ -71,6 +71,7 @@ Fixture make_fixture(std::mt19937& rng, VoxelType type) {
 struct Outcome {
   bool saturated;
   float t;
+  std::uint32_t j;  // grid step of t
   glm::vec4 acc;
   k::ResoctRayStats stats;
 };
@@ -78,6 +79,7 @@ struct Outcome {
 void expect_identical(const Outcome& a, const Outcome& b, int c) {
   ASSERT_EQ(a.saturated, b.saturated) << "case " << c;
   ASSERT_EQ(std::bit_cast<std::uint32_t>(a.t), std::bit_cast<std::uint32_t>(b.t)) << "case " << c;
+  ASSERT_EQ(a.j, b.j) << "case " << c;
   for (int i = 0; i < 4; ++i) {
     ASSERT_EQ(std::bit_cast<std::uint32_t>(a.acc[i]), std::bit_cast<std::uint32_t>(b.acc[i]))
         << "case " << c << " component " << i;
@@ -99,6 +101,7 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
   resoct::cpu::detail::t_ctx = &fx.ctx;
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   int saturated = 0;
+  int on_grid = 0;
   for (int c = 0; c < cases; ++c) {
     k::ResoctFrame f{};
     f.ref_step = 0.002f + u(rng) * 0.01f;
@@ -119,7 +122,10 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
                     (20.0f + u(rng) * 200.0f);
     }
     const float dt = 0.001f + u(rng) * 0.01f;
-    const float t0 = u(rng) * 0.5f;
+    // The segment starts at step j0 of a grid (kernel::resoct_grid_t).
+    const float t_grid = u(rng) * 0.5f;
+    const std::uint32_t j0 = std::uint32_t(rng() % 50u);
+    const float t0 = k::resoct_grid_t(t_grid, j0, dt, -1.0f);
     const float t_exit = t0 + dt * (0.5f + u(rng) * 60.0f);
     const float seg_next = u(rng) < 0.5f ? t_exit + 1.0f : t0 + dt * (1.0f + u(rng) * 40.0f);
     const float seg = k::resoct_segment_length(t0, dt, t_exit);
@@ -128,6 +134,7 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
 
     Outcome start{};
     start.t = t0;
+    start.j = j0;
     const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
     start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
     start.stats.samples = std::uint32_t(rng() % 100u);
@@ -136,15 +143,19 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
     start.stats.marched = u(rng);
 
     Outcome scalar = start, packets = start;
-    scalar.saturated = k::resoct_segment_samples(f, src, dt, t_exit, seg_next, seg, tm, scalar.t,
-                                                 scalar.acc, scalar.stats);
+    scalar.saturated = k::resoct_segment_samples(f, src, dt, t_exit, seg_next, seg, tm, t_grid,
+                                                 scalar.j, scalar.t, scalar.acc, scalar.stats);
     packets.saturated = resoct::cpu::detail::segment_samples_packets(
-        f, src, dt, t_exit, seg_next, seg, tm, packets.t, packets.acc, packets.stats);
+        f, src, dt, t_exit, seg_next, seg, tm, t_grid, packets.j, packets.t, packets.acc,
+        packets.stats);
+    // The grid index follows t: t is step j of the grid (or the end of the ray's progress).
+    if (scalar.t == k::resoct_grid_t(t_grid, scalar.j, dt, -1.0f)) ++on_grid;
     expect_identical(scalar, packets, c);
     if (::testing::Test::HasFatalFailure()) break;
     if (scalar.saturated) ++saturated;
   }
   resoct::cpu::detail::t_ctx = nullptr;
+  EXPECT_GT(on_grid, cases / 2);
   return saturated;
 }
 

@@ -36,7 +36,7 @@ void main() {
   vec3 frac = vec3(1.25f, -0.5f, 0.0f);
   resoct_split_normalize(cell, frac);
   vec3 rel = resoct_relative_origin(cell, frac, ivec3(1048000, 0, 0));
-  vec2 tn = resoct_ray_node_local(rel, dir, vec3(16.0f));
+  vec2 tn = resoct_ray_node_local(rel, resoct_ray_inverse(dir), vec3(16.0f));
 
   float dt = resoct_step_size(dir, vec3(1.0f / 256.0f), 1.0f, 1.0e-6f);
   float t = resoct_advance_t(tt.x, resoct_segment_length(tt.x, dt, tt.y));

@@ -167,8 +167,6 @@ struct VkWindow::Impl {
                     std::uint32_t w, std::uint32_t h) {
     if (image != VK_NULL_HANDLE && iw == w && ih == h) return;
     destroy_image(image, memory, iw, ih);
-    VkImage& frame = image;
-    VkDeviceMemory& frame_memory = memory;
     VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     ici.imageType = VK_IMAGE_TYPE_2D;
     ici.format = kFrameFormat;
@@ -179,14 +177,14 @@ struct VkWindow::Impl {
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
     ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    check(vkCreateImage(device, &ici, nullptr, &frame), "vkCreateImage");
+    check(vkCreateImage(device, &ici, nullptr, &image), "vkCreateImage");
     VkMemoryRequirements req{};
-    vkGetImageMemoryRequirements(device, frame, &req);
+    vkGetImageMemoryRequirements(device, image, &req);
     VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     mai.allocationSize = req.size;
     mai.memoryTypeIndex = memory_type(req.memoryTypeBits, 0);
-    check(vkAllocateMemory(device, &mai, nullptr, &frame_memory), "vkAllocateMemory");
-    check(vkBindImageMemory(device, frame, frame_memory, 0), "vkBindImageMemory");
+    check(vkAllocateMemory(device, &mai, nullptr, &memory), "vkAllocateMemory");
+    check(vkBindImageMemory(device, image, memory, 0), "vkBindImageMemory");
     iw = w;
     ih = h;
   }

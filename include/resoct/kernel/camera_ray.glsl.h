@@ -28,19 +28,34 @@ RESOCT_FN vec3 resoct_frame_voxels_per_box(ResoctFrame f) {
 /// into an exact cell and a fraction in [0, 1).
 RESOCT_FN void resoct_camera_ray(ResoctFrame f, uint px, uint py, RESOCT_OUT(vec3) dir_box,
                                  RESOCT_OUT(ivec3) origin_cell, RESOCT_OUT(vec3) origin_frac) {
-  float rows = float(f.height);
-  float u = (2.0f * (float(px) + 0.5f + f.jitter_x) - float(f.width)) / rows * f.half_height;
-  float v = (rows - 2.0f * (float(py) + 0.5f + f.jitter_y)) / rows * f.half_height;
+  // Every operation here is precise and every quotient a product with a correctly rounded
+  // reciprocal, so that a ray is the same float on every backend: a device compiler may fuse a
+  // multiply-add, divide as x * rcp(y) or normalize with an approximate inverse square root, and
+  // a last-bit difference in a ray's direction moves its step, entry and samples.
+  RESOCT_PRECISE float inv_rows = 1.0f / float(f.height);
+  RESOCT_PRECISE float cx = 2.0f * (float(px) + 0.5f + f.jitter_x) - float(f.width);
+  RESOCT_PRECISE float cy = float(f.height) - 2.0f * (float(py) + 0.5f + f.jitter_y);
+  RESOCT_PRECISE float u = cx * inv_rows * f.half_height;
+  RESOCT_PRECISE float v = cy * inv_rows * f.half_height;
   vec3 fw = vec3(f.forward_x, f.forward_y, f.forward_z);
   vec3 rt = vec3(f.right_x, f.right_y, f.right_z);
   vec3 up = vec3(f.up_x, f.up_y, f.up_z);
   origin_cell = ivec3(f.eye_cell_x, f.eye_cell_y, f.eye_cell_z);
   origin_frac = vec3(f.eye_frac_x, f.eye_frac_y, f.eye_frac_z);
+  RESOCT_PRECISE vec3 ur = u * rt;
+  RESOCT_PRECISE vec3 vu = v * up;
+  RESOCT_PRECISE vec3 offset = ur + vu;
   if (f.projection == RESOCT_PROJECTION_PERSPECTIVE) {
-    dir_box = normalize(fw + u * rt + v * up);
+    RESOCT_PRECISE vec3 d = fw + offset;
+    RESOCT_PRECISE vec3 sq = d * d;
+    RESOCT_PRECISE float len2 = (sq.x + sq.y) + sq.z;
+    RESOCT_PRECISE float inv_len = 1.0f / sqrt(len2);
+    dir_box = d * inv_len;
   } else {
     dir_box = fw;
-    origin_frac = origin_frac + (u * rt + v * up) * resoct_frame_voxels_per_box(f);
+    RESOCT_PRECISE vec3 shift = offset * resoct_frame_voxels_per_box(f);
+    RESOCT_PRECISE vec3 moved = origin_frac + shift;
+    origin_frac = moved;
     resoct_split_normalize(origin_cell, origin_frac);
   }
 }
@@ -56,7 +71,12 @@ RESOCT_FN float resoct_view_depth(ResoctFrame f, vec3 dir_box, float t) {
 RESOCT_FN void resoct_ray_position(ivec3 origin_cell, vec3 origin_frac, vec3 dir_vox, float t,
                                    RESOCT_OUT(ivec3) cell, RESOCT_OUT(vec3) frac) {
   cell = origin_cell;
-  frac = origin_frac + t * dir_vox;
+  // Precise: a device compiler may otherwise fuse this into a multiply-add, rounded once where
+  // the host rounds twice, and the backends' positions (and the nodes and bricks they fall in)
+  // would differ in the last bit.
+  RESOCT_PRECISE vec3 along = t * dir_vox;
+  RESOCT_PRECISE vec3 moved = origin_frac + along;
+  frac = moved;
   resoct_split_normalize(cell, frac);
   // floor(frac) can leave frac == 1.0 after rounding of frac - floor(frac); keep it half-open.
   if (frac.x >= 1.0f) {

@@ -56,23 +56,31 @@ RESOCT_FN uint resoct_allowed_levels(ResoctSlotInfo s) {
   return hi & ~((1u << s.finest_level) - 1u);
 }
 
-/// Parameter offset (from the position) at which the ray leaves the integer box [lo, lo + size),
-/// computed in box-local coordinates so that huge axes neither stall nor overshoot.
-RESOCT_FN float resoct_box_exit(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, vec3 size) {
-  return resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), dir_vox, size).y;
+/// Entry and exit offsets (t relative to the position cell + frac) of the ray with the integer
+/// box [lo, hi), for the ray's reciprocal direction in level-0 voxels `inv_vox`
+/// (resoct_ray_inverse, once per ray), computed in box-local coordinates so that huge axes
+/// neither stall nor overshoot. Sizes are taken as unsigned differences, so an unclipped axis
+/// (corners at +-(2^31 - 1)) is fine.
+RESOCT_FN vec2 resoct_box_offsets(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo, ivec3 hi) {
+  return resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), inv_vox,
+                               vec3(uvec3(hi) - uvec3(lo)));
 }
 
 /// Offset of t from the position at which the ray leaves the integer box [lo, hi) (which holds
-/// the position); sizes are taken as unsigned differences, so an unclipped axis (+-2^31) is fine.
-RESOCT_FN float resoct_box_exit_t(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, ivec3 hi) {
-  return resoct_box_exit(cell, frac, dir_vox, lo, vec3(uvec3(hi) - uvec3(lo)));
+/// the position); see resoct_box_offsets.
+RESOCT_FN float resoct_box_exit_t(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo, ivec3 hi) {
+  return resoct_box_offsets(cell, frac, inv_vox, lo, hi).y;
+}
+
+/// resoct_box_exit_t for the box [lo, lo + size) (a brick or node inside the volume).
+RESOCT_FN float resoct_box_exit(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo, vec3 size) {
+  return resoct_box_exit_t(cell, frac, inv_vox, lo, lo + ivec3(size));
 }
 
 /// Offset of t from the position at which the ray enters the integer box [lo, hi) ahead of it;
 /// infinite when it never does, 0 when the position is already inside.
-RESOCT_FN float resoct_box_entry_t(ivec3 cell, vec3 frac, vec3 dir_vox, ivec3 lo, ivec3 hi) {
-  vec2 ie = resoct_ray_node_local(resoct_relative_origin(cell, frac, lo), dir_vox,
-                                  vec3(uvec3(hi) - uvec3(lo)));
+RESOCT_FN float resoct_box_entry_t(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo, ivec3 hi) {
+  vec2 ie = resoct_box_offsets(cell, frac, inv_vox, lo, hi);
   if (!(ie.x < ie.y) || !(ie.y > 0.0f)) return RESOCT_RAY_T_INF;
   return max(ie.x, 0.0f);
 }
@@ -305,7 +313,7 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
 /// Page-table mode, one channel: the target level or nothing (requested); [lo, hi) is clipped to
 /// the target brick. `skip_exit` receives the exit offset of an EMPTY brick.
 RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                               ivec3 cell, vec3 frac, vec3 dir_vox,
+                                               ivec3 cell, vec3 frac, vec3 inv_vox,
                                                RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
                                                RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
                                                RESOCT_INOUT(ResoctRayStats) st) {
@@ -322,7 +330,7 @@ RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotI
   ResoctSource src = resoct_entry_source(s, e, target, L, bs, b);
   if (src.kind == RESOCT_CH_EMPTY) {
     skip_exit =
-        resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b), resoct_brick_size0(L, bs));
+        resoct_box_exit(cell, frac, inv_vox, resoct_brick_lo0(L, bs, b), resoct_brick_size0(L, bs));
   }
   return src;
 }
@@ -333,7 +341,7 @@ RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotI
 /// the channel empty there. [lo, hi) is clipped to the target brick, which every brick of the
 /// walk contains.
 RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                            ivec3 cell, vec3 frac, vec3 dir_vox,
+                                            ivec3 cell, vec3 frac, vec3 inv_vox,
                                             RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
                                             RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
                                             RESOCT_INOUT(ResoctRayStats) st) {
@@ -357,7 +365,7 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
       break;
     }
     if (state == RESOCT_PAGE_STATE_EMPTY && !resoct_empty_page_shows(s, e)) {
-      skip_exit = resoct_box_exit(cell, frac, dir_vox, resoct_brick_lo0(L, bs, b),
+      skip_exit = resoct_box_exit(cell, frac, inv_vox, resoct_brick_lo0(L, bs, b),
                                   resoct_brick_size0(L, bs));
       return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
     }

@@ -163,7 +163,7 @@ RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, Res
     rgba = resoct_tf_lookup(s.slot, pv);
     a = min(rgba.a, 1.0f);
   } else {
-    rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, pv, seg / p.ref_step);
+    rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, s.slot, pv, resoct_step_ratio(seg, p.ref_step));
     a = rgba.a;
   }
   vec3 rgb = vec3(rgba.r, rgba.g, rgba.b);

@@ -45,11 +45,12 @@ RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint 
 /// where the ray leaves a node through an edge or a corner. Which face the ray leaves through is
 /// decided by comparing products, which both backends round alike (a quotient may differ in its
 /// last bit on a device), so that the nodes visited are the same on every backend; the exits
-/// themselves are computed from the sample's exact position, as the current node's is.
+/// themselves are computed from the sample's exact position, as the current node's is (`inv_vox`:
+/// the reciprocal of `dir_vox`, resoct_ray_inverse).
 RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint cls,
                                     uint depth, uvec3 coord, ivec3 lo, ivec3 cell, vec3 frac,
-                                    vec3 dir_vox, float node_end, ivec3 box_lo, ivec3 box_hi,
-                                    RESOCT_INOUT(ResoctRayStats) stats) {
+                                    vec3 dir_vox, vec3 inv_vox, float node_end, ivec3 box_lo,
+                                    ivec3 box_hi, RESOCT_INOUT(ResoctRayStats) stats) {
   ResoctDepthInfo D = resoct_read_depth(depth);
   ivec3 ne = ivec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
   uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
@@ -87,7 +88,7 @@ RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint l
     if (any(lessThan(lo, box_lo)) || any(greaterThan(lo + ne, box_hi))) break;
     stats.nodes = stats.nodes + 1u;
     if (!resoct_node_class_all(f, bank, n, live, resoct_node_index(depth, coord, lg), cls)) break;
-    end = max(end, resoct_box_exit_t(cell, frac, dir_vox, lo, lo + ne));
+    end = max(end, resoct_box_exit_t(cell, frac, inv_vox, lo, lo + ne));
   }
   return end;
 }

@@ -28,18 +28,21 @@ RESOCT_KERNEL_BEGIN
 RESOCT_CONST(float, RESOCT_SEGMENT_LOOP_MIN_STEPS, 2.0f);
 
 /// Samples `src` (RESOCT_CH_VALUE) from the sample at `tm` (segment [t, t + seg)) while its
-/// midpoint lies before `seg_next`. Returns true when the ray saturated (early termination);
+/// midpoint lies before `seg_next`. t is step `grid_j` of the grid that starts at `t_grid`
+/// (resoct_grid_t); grid_j follows t. Returns true when the ray saturated (early termination);
 /// otherwise `t` is the start of the next sample, which the march must see first: the ray's end,
 /// the iteration cap, or a new decision. `acc` is the premultiplied accumulated colour; samples,
 /// brick accesses, iterations and marched length are counted in `stats` as the march's
 /// per-sample path counts them.
 RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src, float dt,
                                            float t_exit, float seg_next, float seg, float tm,
+                                           float t_grid, RESOCT_INOUT(uint) grid_j,
                                            RESOCT_INOUT(float) t, RESOCT_INOUT(vec4) acc,
                                            RESOCT_INOUT(ResoctRayStats) stats) {
   // The loop's state in locals, written back once: in C++ the references could alias nothing
   // here, but locals make it plain to the compiler (and cost nothing in GLSL).
   float t_now = t;
+  uint j = grid_j;
   vec4 a = acc;
   uint samples = stats.samples;
   uint accesses = stats.brick_accesses;
@@ -56,7 +59,7 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
           src.inv_range_width);
     }
     vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
-    float alpha = resoct_correct_opacity(rgba.a, seg / f.ref_step);
+    float alpha = resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step));
     samples = samples + 1u;
     // resoct_mix_result of this one channel: its colour premultiplied (0 where alpha is 0).
     vec4 sample_pm =
@@ -67,7 +70,8 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
       break;
     }
     marched = marched + seg;
-    t_now = resoct_advance_t(t_now, seg);
+    j = j + 1u;
+    t_now = resoct_grid_t(t_grid, j, dt, t_now);
     if (!(t_exit - t_now > RESOCT_SEGMENT_EPS * dt) || iterations >= f.max_iterations) break;
     seg = resoct_segment_length(t_now, dt, t_exit);
     tm = t_now + 0.5f * seg;
@@ -75,6 +79,7 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
     iterations = iterations + 1u;
   }
   t = t_now;
+  grid_j = j;
   acc = a;
   stats.samples = samples;
   stats.brick_accesses = accesses;

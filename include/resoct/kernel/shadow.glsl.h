@@ -54,13 +54,15 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
   st.shadow_rays = st.shadow_rays + 1u;
   vec3 vpb = resoct_fx_voxels_per_box(p);
   vec3 dir_vox = light * vpb;
+  vec3 inv_vox = resoct_ray_inverse(dir_vox);
   uint base = min(lod + p.shadow_lod_shift, sp.level_count - 1u);
   ResoctLevelInfo Lb = resoct_read_level(base);
   vec3 level_voxel = vec3(uvec3(1u) << resoct_level_factor(Lb)) / vpb;
   float dt = resoct_step_size(light, level_voxel, p.step_scale, p.min_step);
+  float inv_dt = 1.0f / dt;
   vec3 vol_lo = vec3(-cell0);
   vec3 vol_hi = vec3(ivec3(int(p.extent_x), int(p.extent_y), int(p.extent_z)) - cell0);
-  float t_exit = min(resoct_ray_box(frac0, dir_vox, vol_lo, vol_hi).y, max_t);
+  float t_exit = min(resoct_ray_box_inv(frac0, inv_vox, vol_lo, vol_hi).y, max_t);
   uint depth = resoct_traversal_depth_for(p.start_depth, p.depth_count, vpb, dt);
   ResoctDepthInfo Dt = resoct_read_depth(depth);
   uvec3 dlog2 = resoct_depth_count_log2(Dt);
@@ -104,8 +106,8 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
     }
     if (empty == all) {
       uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
-      float e = resoct_box_exit(cell, frac, dir_vox, ivec3(coord * ne), vec3(ne));
-      float k = max(1.0f, resoct_ceil((0.5f * seg + e - 0.5f * dt) / dt));
+      float e = resoct_box_exit(cell, frac, inv_vox, ivec3(coord * ne), vec3(ne));
+      float k = max(1.0f, resoct_ceil((0.5f * seg + e - 0.5f * dt) * inv_dt));
       t = resoct_advance_t(t, k * dt);
       continue;
     }
@@ -131,7 +133,8 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
         prev[c] = value;
         have_prev = have_prev | (1u << c);
       } else {
-        float a = resoct_correct_opacity(resoct_tf_lookup(s.slot, value).a, seg / p.ref_step);
+        float a = resoct_correct_opacity(resoct_tf_lookup(s.slot, value).a,
+                                         resoct_step_ratio(seg, p.ref_step));
         transmit = transmit * (1.0f - a);
       }
     }

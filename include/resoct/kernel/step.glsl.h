@@ -43,9 +43,11 @@ RESOCT_CONST(float, RESOCT_LOD_MIN_FOOTPRINT, 1.0e-30f);
 RESOCT_FN float resoct_step_size(vec3 dir, vec3 voxel_size, float step_scale, float min_step) {
   vec3 ad = abs(dir);
   float dt = RESOCT_RAY_T_INF;
-  if (ad.x >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.x / ad.x);
-  if (ad.y >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.y / ad.y);
-  if (ad.z >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.z / ad.z);
+  // Products with correctly rounded reciprocals, not quotients: a device may divide as
+  // x * rcp(y), and the step must be the same float on every backend (kernel/ray.glsl.h).
+  if (ad.x >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.x * (1.0f / ad.x));
+  if (ad.y >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.y * (1.0f / ad.y));
+  if (ad.z >= RESOCT_RAY_PARALLEL_EPS) dt = min(dt, voxel_size.z * (1.0f / ad.z));
   if (dt >= RESOCT_RAY_T_INF) dt = min(voxel_size.x, min(voxel_size.y, voxel_size.z));
   return max(dt * step_scale, min_step);
 }
@@ -55,6 +57,26 @@ RESOCT_FN float resoct_advance_t(float t, float dt) {
   float next = t + dt;
   if (next <= t) next = t + max(abs(t) * RESOCT_T_ULP_FACTOR, RESOCT_T_MIN_ADVANCE);
   return next;
+}
+
+/// The start of step j of a march whose step grid starts at t_grid: t_grid + j * dt, each
+/// operation rounded once (precise: no fused multiply-add on a device), so a sample's position
+/// depends on its index alone and never on how the march reached it: one skip of k steps and k
+/// single steps land on the same t, whichever nodes the skips were computed from. `t` is the
+/// current step's start; where dt is below its ulp the result is resoct_advance_t(t, dt), so
+/// every iteration still makes progress. j is exact up to 2^24 (far above any iteration cap).
+RESOCT_FN float resoct_grid_t(float t_grid, uint j, float dt, float t) {
+  RESOCT_PRECISE float jdt = float(j) * dt;
+  RESOCT_PRECISE float next = t_grid + jdt;
+  if (next <= t) next = resoct_advance_t(t, dt);
+  return next;
+}
+
+/// A segment's length in units of the reference step Δ₀ (the opacity correction's exponent), as
+/// a product with the correctly rounded reciprocal: a device may divide as x * rcp(y), and the
+/// ratio decides early termination, so it must be the same float on every backend.
+RESOCT_FN float resoct_step_ratio(float seg, float ref_step) {
+  return seg * (1.0f / ref_step);
 }
 
 /// Length of the segment that starts at t: the step, shortened at the exit so that segments tile

@@ -92,11 +92,13 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   vec3 o_frac;
   resoct_camera_ray(f, px, py, dir_box, o_cell, o_frac);
   vec3 dir_vox = dir_box * resoct_frame_voxels_per_box(f);
+  // Every ray/box test of the march multiplies by these (kernel/ray.glsl.h).
+  vec3 inv_vox = resoct_ray_inverse(dir_vox);
 
   // Volume interval relative to the origin cell: exact integer box corners.
   vec3 vol_lo = vec3(-o_cell);
   vec3 vol_hi = vec3(ivec3(int(f.extent_x), int(f.extent_y), int(f.extent_z)) - o_cell);
-  vec2 tv = resoct_ray_box(o_frac, dir_vox, vol_lo, vol_hi);
+  vec2 tv = resoct_ray_box_inv(o_frac, inv_vox, vol_lo, vol_hi);
   float t = max(tv.x, 0.0f);
   float t_exit = tv.y;
   if (!(t < t_exit)) return resoct_over_background(acc, background);
@@ -153,6 +155,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   float t_enter = t;
   // Jittered accumulation: every sample moves by jitter_sample steps (t + 0 * dt == t).
   t = t + f.jitter_sample * dt;
+  // The step grid: step j starts at t_grid + j * dt (resoct_grid_t), so skipping changes which
+  // samples run but never where they are, to the bit. Restarted at each slice or lens stop.
+  float t_grid = t;
+  uint grid_j = 0u;
+  float inv_dt = 1.0f / dt;  // skips count steps with a product (same float on every backend)
 
   // The march ends when less than RESOCT_SEGMENT_EPS of a step remains: such a sliver adds no
   // visible opacity, and its existence would hinge on the last ulp of t_exit, which differs
@@ -431,7 +438,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             ivec3 ihi = class_hi - margin;
             if (resoct_in_box(cell, ilo, ihi)) {
               skip = true;
-              skip_exit = resoct_box_exit_t(cell, frac, dir_vox, ilo, ihi);
+              skip_exit = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
               // At level 0 (no margin) the skip goes on through the empty nodes that follow.
               bool run = all(equal(margin, ivec3(0)));
               RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
@@ -440,12 +447,12 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               if (run) {
                 skip_exit = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_EMPTY,
                                                 cached_skip_depth, resoct_node_coord(Ds, cell),
-                                                class_lo, cell, frac, dir_vox, skip_exit,
+                                                class_lo, cell, frac, dir_vox, inv_vox, skip_exit,
                                                 ivec3(-2147483647), ivec3(2147483647), stats);
               }
             } else {
-              node_t_end = min(resoct_box_exit_t(cell, frac, dir_vox, class_lo, class_hi),
-                               resoct_box_entry_t(cell, frac, dir_vox, ilo, ihi));
+              node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
+                               resoct_box_entry_t(cell, frac, inv_vox, ilo, ihi));
             }
           } else {
             class_lo = cached_lo;
@@ -459,12 +466,12 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               ihi = ihi - margin;
             }
             if (resoct_in_box(cell, ilo, ihi)) {
-              node_t_end = resoct_box_exit_t(cell, frac, dir_vox, ilo, ihi);
+              node_t_end = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
             } else {
               class_empty = 0u;
               class_homog = 0u;
-              node_t_end = min(resoct_box_exit_t(cell, frac, dir_vox, class_lo, class_hi),
-                               resoct_box_entry_t(cell, frac, dir_vox, ilo, ihi));
+              node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
+                               resoct_box_entry_t(cell, frac, inv_vox, ilo, ihi));
             }
           }
           // Sources stay while they hold (their bricks, the LOD level) unless the classes
@@ -520,10 +527,10 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               float exit_c = 0.0f;
               if (f.mode == RESOCT_MODE_OCTREE) {
-                src[c] = resoct_octree_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                src[c] = resoct_octree_source(sp, s, target, cell, frac, inv_vox, last_key[c],
                                               src_lo, src_hi, exit_c, stats);
               } else {
-                src[c] = resoct_pagetable_source(sp, s, target, cell, frac, dir_vox, last_key[c],
+                src[c] = resoct_pagetable_source(sp, s, target, cell, frac, inv_vox, last_key[c],
                                                  src_lo, src_hi, exit_c, stats);
               }
               if (src[c].kind == RESOCT_CH_EMPTY) {
@@ -539,7 +546,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           } else {
             // The sources hold until the ray leaves their boxes or the LOD level may change
             // (docs/rendering.md "Segments").
-            seg_t_end = min(lod_t_end, tm + resoct_box_exit_t(cell, frac, dir_vox, src_lo, src_hi));
+            seg_t_end = min(lod_t_end, tm + resoct_box_exit_t(cell, frac, inv_vox, src_lo, src_hi));
             seg_box_lo = src_lo;
             seg_box_hi = src_hi;
             have_seg = true;
@@ -563,8 +570,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         }
         if (merge) {
           node_t_end = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_VISIBLE, cap_depth,
-                                           cached_coord, class_lo, cell, frac, dir_vox, node_t_end,
-                                           seg_box_lo, seg_box_hi, stats);
+                                           cached_coord, class_lo, cell, frac, dir_vox, inv_vox,
+                                           node_t_end, seg_box_lo, seg_box_hi, stats);
         }
         if (!skip) node_t_end = tm + node_t_end;
         seg_next = min(seg_t_end, node_t_end);
@@ -580,8 +587,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                  seg_next - tm >= RESOCT_SEGMENT_LOOP_MIN_STEPS * dt;
       }
       if (single) {
-        stop = RESOCT_SEGMENT_SAMPLES(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm, t,
-                                      acc, stats);
+        stop = RESOCT_SEGMENT_SAMPLES(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm,
+                                      t_grid, grid_j, t, acc, stats);
         if (stop) break;
         continue;
       }
@@ -592,7 +599,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       resoct_mix_begin(weighted, combined);
       if (!skip) {
         RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-          acc = resoct_preint_begin_sample(pr, seg_lod, seg / f.ref_step, acc);
+          acc = resoct_preint_begin_sample(pr, seg_lod, resoct_step_ratio(seg, f.ref_step), acc);
         }
         // Effects: the channels' values are collected and handled by one call below, so the GPU
         // compiler inlines the effect code once, not once per render mode.
@@ -622,8 +629,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             fx_have = fx_have | (1u << c);
           }
           else {
-            vec4 rgba =
-                RESOCT_FX(resoct_dvr_sample)(pr, c, src[c].tf_slot, value, seg / f.ref_step);
+            vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, src[c].tf_slot, value,
+                                                     resoct_step_ratio(seg, f.ref_step));
             resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
           }
           any_value = true;
@@ -642,7 +649,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         }
       } else {
         RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
-          acc = resoct_preint_begin_sample(pr, seg_lod, seg / f.ref_step, acc);
+          acc = resoct_preint_begin_sample(pr, seg_lod, resoct_step_ratio(seg, f.ref_step), acc);
           acc = resoct_preint_end_sample(pr, acc);
         }
       }
@@ -659,13 +666,21 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       if (skip) {
         // First grid segment whose midpoint lies past the exit: sample positions stay those of
         // an unskipped march.
-        float k = max(1.0f, resoct_ceil((0.5f * seg + skip_exit - 0.5f * dt) / dt));
-        float t_next = resoct_advance_t(t, k * dt);
+        float k = max(1.0f, resoct_ceil((0.5f * seg + skip_exit - 0.5f * dt) * inv_dt));
+        float t_next;
+        if (k < 16777216.0f) {
+          grid_j = grid_j + uint(k);
+          t_next = resoct_grid_t(t_grid, grid_j, dt, t);
+        } else {
+          // Past any ray's end (an exit at infinity): no grid index needed.
+          t_next = resoct_advance_t(t, k * dt);
+        }
         stats.skipped = stats.skipped + (min(t_next, t_exit) - t);
         t = t_next;
       } else {
         stats.marched = stats.marched + seg;
-        t = resoct_advance_t(t, seg);
+        grid_j = grid_j + 1u;
+        t = resoct_grid_t(t_grid, grid_j, dt, t);
       }
     }
     RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
@@ -677,6 +692,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
       break;
     }
     have_seg = false;
+    t_grid = t;
+    grid_j = 0u;
   }
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     acc = resoct_fx_projection_composite(fx, n, live_anywhere, t_exit - t_enter, acc);

@@ -108,6 +108,27 @@ TEST(KernelRay, DegenerateDirectionsNeverNaN) {
   EXPECT_FALSE(resoct_ray_hits(d, 0.0f));
 }
 
+TEST(KernelRay, ReciprocalMarksParallelAxesWithZero) {
+  // 0 stands for "parallel": zero, negative zero, denormals and anything below the threshold.
+  const float tiny = std::numeric_limits<float>::denorm_min();
+  EXPECT_EQ(resoct_ray_inverse1(0.0f), 0.0f);
+  EXPECT_EQ(resoct_ray_inverse1(-0.0f), 0.0f);
+  EXPECT_EQ(resoct_ray_inverse1(tiny), 0.0f);
+  EXPECT_EQ(resoct_ray_inverse1(-0.5f * RESOCT_RAY_PARALLEL_EPS), 0.0f);
+  // Anything else is the correctly rounded reciprocal, finite and never 0.
+  EXPECT_EQ(resoct_ray_inverse1(4.0f), 0.25f);
+  EXPECT_EQ(resoct_ray_inverse1(-3.0f), 1.0f / -3.0f);
+  const float r = resoct_ray_inverse1(RESOCT_RAY_PARALLEL_EPS);
+  EXPECT_TRUE(std::isfinite(r));
+  EXPECT_GT(r, 0.0f);
+  // A parallel axis decides by position alone, through the reciprocal form as well.
+  const vec3 inv = resoct_ray_inverse(vec3(1.0f, -0.0f, tiny));
+  EXPECT_TRUE(resoct_ray_hits(
+      resoct_ray_box_inv(vec3(-1.0f, 0.5f, 0.0f), inv, vec3(0.0f), vec3(1.0f)), 0.0f));
+  EXPECT_FALSE(resoct_ray_hits(
+      resoct_ray_box_inv(vec3(-1.0f, 1.0f, 0.5f), inv, vec3(0.0f), vec3(1.0f)), 0.0f));
+}
+
 TEST(KernelRay, GrazingRaysMatchBruteForceMarching) {
   // Random rays, many of them nearly parallel to a face, compared with dense point sampling of
   // the half-open box in double.
@@ -154,7 +175,8 @@ TEST(KernelRay, NodeLocalCoordinatesKeepPrecisionAt2Pow20) {
   const ivec3 node_lo(1048000, 0, 0);
   const vec3 rel = resoct_relative_origin(cell, frac, node_lo);
   EXPECT_NEAR(rel.x, 1.3f, 1e-6f);
-  const vec2 t = resoct_ray_node_local(rel, vec3(1.0f, 0.0f, 0.0f), vec3(16.0f));
+  const vec2 t =
+      resoct_ray_node_local(rel, resoct_ray_inverse(vec3(1.0f, 0.0f, 0.0f)), vec3(16.0f));
   EXPECT_NEAR(t.y, 14.7f, 1e-5f);  // distance to the node's upper face, to float precision
   // The same in global normalized floats carries an error of a sizeable fraction of a voxel
   // (floats near 1 are 2^-24 apart, 1/16 voxel at 2^20 voxels).
