@@ -5,6 +5,7 @@
 //   BM_OctreeAddEvict/<leaf>/<slots>/<level>  one brick_added + one brick_evicted per item
 //   BM_OctreeAdd/..., BM_OctreeEvict/...      the two halves separately, in batches of distinct
 //                                             bricks (the other half paused)
+//   BM_OctreeMetadataFromBrick/<leaf>/<smooth> exact leaf metadata from one level-0 brick
 // ns_per_brick is CPU time per item (per add+evict pair, or per add / per evict); Google Benchmark
 // prints inverted rates with an "s" suffix, so "907.6s" there means 907.6 ns.
 //
@@ -178,7 +179,40 @@ void depth_and_slots(benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kNanosecond);
 }
 
+// What the renderer adds to each level-0 brick upload: exact metadata of the leaves inside the
+// brick from its voxels (metadata_from_brick), one slot, u16 voxels: <smooth> 0 = random values
+// (every row spans many occupancy bins: the worst case), 1 = a smooth ramp along z.
+void BM_OctreeMetadataFromBrick(benchmark::State& state) {
+  const auto leaf = std::uint32_t(state.range(0));
+  const bool smooth = state.range(1) != 0;
+  Setup setup(1);
+  ResidencyOctree tree(setup.hierarchy, OctreeLayout{glm::u64vec3(extent()), glm::uvec3(leaf)}, 1,
+                       setup.query());
+  const std::size_t count = setup.hierarchy.layout().padded_voxels();
+  const std::size_t slice = std::size_t(setup.hierarchy.layout().padded_size().x) *
+                            setup.hierarchy.layout().padded_size().y;
+  std::vector<std::byte> voxels(count * 2);
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto v = std::uint16_t(smooth ? 20000u + 400u * (i / slice) : rng() & 0xffffu);
+    std::memcpy(voxels.data() + 2 * i, &v, 2);
+  }
+  const glm::uvec3 n = setup.hierarchy.level(0).bricks;
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    const glm::uvec3 b(std::uint32_t(i % n.x), std::uint32_t((i / n.x) % n.y),
+                       std::uint32_t((i / n.x / n.y) % n.z));
+    tree.metadata_from_brick(0, 0, b, voxels);
+    if (++i % 1024 == 0) benchmark::DoNotOptimize(tree.take_deltas());
+  }
+  state.counters["ns_per_brick"] = benchmark::Counter(
+      double(state.iterations()) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 BENCHMARK(BM_OctreeAddEvict)->Apply(depth_and_slots);
+BENCHMARK(BM_OctreeMetadataFromBrick)
+    ->ArgsProduct({{8, 16, 32}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_OctreeAdd)->Args({16, 4, 0})->Args({16, 4, 2})->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_OctreeEvict)->Args({16, 4, 0})->Args({16, 4, 2})->Unit(benchmark::kNanosecond);
 

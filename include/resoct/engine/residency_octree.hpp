@@ -104,15 +104,18 @@ class ResidencyOctree {
   /// are recomputed by OR while anything changes.
   void brick_evicted(std::uint32_t slot, std::uint32_t level, glm::uvec3 brick);
 
-  /// Conservative metadata of the level-0 voxels inside a node (a source's region_meta answer for
-  /// node_box(node), occupancy over this slot's range). Replaces earlier data supplied for the
-  /// same node and discards its coarse-brick estimate; ancestors are updated while they change.
-  /// Throws Error(out_of_range) for a bad slot or node or a node outside the volume.
+  /// Conservative metadata of the level-0 voxels a node's samples read (a source's region_meta
+  /// answer for OctreeLayout::sampling_support(node), occupancy over this slot's range). Replaces
+  /// earlier data supplied for the same node and discards its coarse-brick estimate; ancestors are
+  /// updated while they change. Throws Error(out_of_range) for a bad slot or node or a node outside
+  /// the volume.
   void node_metadata(std::uint32_t slot, std::uint64_t node, const RegionMeta& meta);
 
-  /// Fallback for sources without region metadata: derives metadata from a brick's voxels
-  /// (`voxels` as written by BrickSource::read_brick, padded, of the volume's type).
-  /// Level 0: every leaf fully inside the brick gets exact (VALID) metadata of its voxels.
+  /// Metadata from a brick's voxels (`voxels` as written by BrickSource::read_brick, padded, of
+  /// the volume's type). Level 0: every leaf fully inside the brick whose sampling support the
+  /// padded brick holds (a halo of at least one voxel) gets exact (VALID) metadata of the
+  /// support's voxels; where the node also has conservative data (node_metadata) the record is
+  /// the intersection of both, so a resident level-0 brick tightens a coarse region answer.
   /// Level l > 0: every node fully inside the brick at the deepest depth whose nodes are no
   /// smaller than a level-l voxel gets an APPROX estimate from the averaged voxels over it. An
   /// estimate replaces one from the same or a coarser level and is ignored once the node has

@@ -69,7 +69,8 @@ RESOCT_FN vec2 resoct_box_offsets(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo,
 /// Offset of t from the position at which the ray leaves the integer box [lo, hi) (which holds
 /// the position); see resoct_box_offsets.
 RESOCT_FN float resoct_box_exit_t(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo, ivec3 hi) {
-  return resoct_box_offsets(cell, frac, inv_vox, lo, hi).y;
+  return resoct_ray_box_exit_inv(resoct_relative_origin(cell, frac, lo), inv_vox, vec3(0.0f),
+                                 vec3(uvec3(hi) - uvec3(lo)));
 }
 
 /// resoct_box_exit_t for the box [lo, lo + size) (a brick or node inside the volume).

@@ -212,6 +212,9 @@ struct ResoctDepthInfo {
   uint count_log2_x;  // log2 of count_x .. count_z (counts are powers of two)
   uint count_log2_y;
   uint count_log2_z;
+  uint axis_bits_x;  // the bits of a local index that hold the x (y, z) coordinate: a step to
+  uint axis_bits_y;  //   the neighbour along an axis is an add within them
+  uint axis_bits_z;  //   (resoct_node_neighbor_local)
 };
 
 // What one ray reports besides its colour (summed per frame by the backend).

@@ -107,6 +107,21 @@ RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
   return resoct_read_depth(depth).first_node + local;
 }
 
+/// Local index of the neighbour one node along an axis (`step` +1 or -1) of the node with local
+/// index `local`, for that axis's bits of the local index at the node's depth
+/// (ResoctDepthInfo.axis_bits_*): the axis coordinate is spread over those bits, so the step is an
+/// add within them, the carry passing over the other axes' bits. The caller keeps the coordinate
+/// inside the depth's node counts (a step past the edge wraps within the bits).
+RESOCT_FN uint resoct_node_neighbor_local(uint local, uint axis_bits, int step) {
+  uint moved = step > 0 ? ((local | ~axis_bits) + 1u) : ((local & axis_bits) - 1u);
+  return (moved & axis_bits) | (local & ~axis_bits);
+}
+
+/// The axis bits of depth D for axis `axis` (0 x, 1 y, 2 z).
+RESOCT_FN uint resoct_depth_axis_bits(ResoctDepthInfo D, uint axis) {
+  return axis == 0u ? D.axis_bits_x : (axis == 1u ? D.axis_bits_y : D.axis_bits_z);
+}
+
 /// Class of a channel at the node of depth `depth`: its own record if it has metadata, else that
 /// of the nearest ancestor (down to `top`) that has, since a parent's record covers its children;
 /// INVALID when none has. Walks up by shifting the node's local index (a parent's local index is

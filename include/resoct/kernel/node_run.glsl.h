@@ -33,8 +33,8 @@ RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint 
   return true;
 }
 
-/// The end of a run of nodes of one class along the ray. The run starts at the node of depth
-/// `depth` with coordinates `coord` and level-0 corner `lo`, which holds the sample at (cell,
+/// The end of a run of nodes of one class along the ray. The run starts at the node `node` of
+/// depth `depth` with coordinates `coord` and level-0 corner `lo`, which holds the sample at (cell,
 /// frac) and which the ray leaves at `node_end` (t relative to the sample); the nodes the ray
 /// enters next continue it while every live channel's own record has the class `cls`: EMPTY (a
 /// skip goes on through them) or VISIBLE (crossing into them is no decision). A node's metadata
@@ -48,13 +48,14 @@ RESOCT_FN bool resoct_node_class_all(RESOCT_FRAME_IN f, uint bank, uint n, uint 
 /// themselves are computed from the sample's exact position, as the current node's is (`inv_vox`:
 /// the reciprocal of `dir_vox`, resoct_ray_inverse).
 RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint live, uint cls,
-                                    uint depth, uvec3 coord, ivec3 lo, ivec3 cell, vec3 frac,
-                                    vec3 dir_vox, vec3 inv_vox, float node_end, ivec3 box_lo,
-                                    ivec3 box_hi, RESOCT_INOUT(ResoctRayStats) stats) {
+                                    uint depth, uint node, uvec3 coord, ivec3 lo, ivec3 cell,
+                                    vec3 frac, vec3 dir_vox, vec3 inv_vox, float node_end,
+                                    ivec3 box_lo, ivec3 box_hi,
+                                    RESOCT_INOUT(ResoctRayStats) stats) {
   ResoctDepthInfo D = resoct_read_depth(depth);
   ivec3 ne = ivec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
   uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
-  uvec3 lg = resoct_depth_count_log2(D);
+  uint local = node - D.first_node;
   vec3 ad = abs(dir_vox);
   float end = node_end;
   for (uint i = 0u; i < RESOCT_NODE_RUN_LENGTH; ++i) {
@@ -84,10 +85,11 @@ RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint l
     // Unsigned: stepping below 0 wraps past the count.
     coord[axis] = uint(int(coord[axis]) + dstep);
     if (coord[axis] >= count[axis]) break;
+    local = resoct_node_neighbor_local(local, resoct_depth_axis_bits(D, axis), dstep);
     lo[axis] = lo[axis] + dstep * ne[axis];
     if (any(lessThan(lo, box_lo)) || any(greaterThan(lo + ne, box_hi))) break;
     stats.nodes = stats.nodes + 1u;
-    if (!resoct_node_class_all(f, bank, n, live, resoct_node_index(depth, coord, lg), cls)) break;
+    if (!resoct_node_class_all(f, bank, n, live, D.first_node + local, cls)) break;
     end = max(end, resoct_box_exit_t(cell, frac, inv_vox, lo, lo + ne));
   }
   return end;

@@ -60,6 +60,13 @@ RESOCT_FN vec2 resoct_ray_slab(float origin, float inv, float lo, float hi) {
   return vec2(min(t0, t1), max(t0, t1));
 }
 
+/// The exit of resoct_ray_slab alone, the same float: only the far face's product is taken (the
+/// max of the two products is the far face's, as rounding is monotonic).
+RESOCT_FN float resoct_ray_slab_exit(float origin, float inv, float lo, float hi) {
+  if (inv == 0.0f) return origin >= lo && origin < hi ? RESOCT_RAY_T_INF : -RESOCT_RAY_T_INF;
+  return ((inv > 0.0f ? hi : lo) - origin) * inv;
+}
+
 /// Entry and exit parameters of the ray origin + t * dir with the half-open box [lo, hi), for the
 /// ray's reciprocal direction `inv` (resoct_ray_inverse). Hit iff result.x < result.y. Never NaN
 /// for finite inputs.
@@ -68,6 +75,13 @@ RESOCT_FN vec2 resoct_ray_box_inv(vec3 origin, vec3 inv, vec3 lo, vec3 hi) {
   vec2 sy = resoct_ray_slab(origin.y, inv.y, lo.y, hi.y);
   vec2 sz = resoct_ray_slab(origin.z, inv.z, lo.z, hi.z);
   return vec2(max(sx.x, max(sy.x, sz.x)), min(sx.y, min(sy.y, sz.y)));
+}
+
+/// The exit of resoct_ray_box_inv alone (resoct_ray_box_inv(...).y, the same float).
+RESOCT_FN float resoct_ray_box_exit_inv(vec3 origin, vec3 inv, vec3 lo, vec3 hi) {
+  return min(resoct_ray_slab_exit(origin.x, inv.x, lo.x, hi.x),
+             min(resoct_ray_slab_exit(origin.y, inv.y, lo.y, hi.y),
+                 resoct_ray_slab_exit(origin.z, inv.z, lo.z, hi.z)));
 }
 
 /// resoct_ray_box_inv for a direction `dir` (its reciprocal taken here): for one-off tests; a

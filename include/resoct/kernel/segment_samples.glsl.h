@@ -23,10 +23,6 @@
 
 RESOCT_KERNEL_BEGIN
 
-/// Fewest steps to the next decision for which the march enters the loop (fewer: one sample per
-/// pass of the march, the same arithmetic).
-RESOCT_CONST(float, RESOCT_SEGMENT_LOOP_MIN_STEPS, 2.0f);
-
 /// Samples `src` (RESOCT_CH_VALUE) from the sample at `tm` (segment [t, t + seg)) while its
 /// midpoint lies before `seg_next`. t is step `grid_j` of the grid that starts at `t_grid`
 /// (resoct_grid_t); grid_j follows t. Returns true when the ray saturated (early termination);

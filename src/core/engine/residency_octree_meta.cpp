@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <type_traits>
 #include <string>
 
 #include "resoct/base/error.hpp"
@@ -13,6 +15,17 @@ namespace resoct {
 
 namespace k = resoct::kernel;
 
+namespace {
+
+// The intersection of two min/max words that both bound the same values (0: no values).
+std::uint32_t intersect_minmax(std::uint32_t a, std::uint32_t b) {
+  const std::uint32_t r =
+      (std::min(a >> 16u, b >> 16u) << 16u) | std::min(a & 0xffffu, b & 0xffffu);
+  return k::resoct_node_range_empty(r) ? 0u : r;
+}
+
+}  // namespace
+
 ResidencyOctree::Record ResidencyOctree::compute_record(
     std::uint32_t d, std::uint64_t node, glm::uvec3 coord, std::uint32_t slot,
     std::span<const std::uint32_t> storage) const {
@@ -20,11 +33,16 @@ ResidencyOctree::Record ResidencyOctree::compute_record(
   const auto it = own_.find(node * slots_ + slot);
   const OwnMeta* own = it == own_.end() ? nullptr : &it->second;
   const bool own_conservative = own != nullptr && (own->has_direct || own->has_exact);
-  if (own != nullptr && own->has_direct) {
+  if (own != nullptr && own->has_direct && own->has_exact) {
+    // Both bound the values of the node's sampling support, so their intersection does too: a
+    // region answer from a source's metadata blocks is often much wider than the scan of a
+    // level-0 brick (a 16³ block grid answers for 48³ voxels around a 16³ leaf).
+    r.minmax = intersect_minmax(own->direct_minmax, own->exact_minmax);
+    r.occupancy = own->direct_occupancy & own->exact_occupancy;
+  } else if (own != nullptr && own->has_direct) {
     r.minmax = k::resoct_node_merge_minmax(r.minmax, own->direct_minmax);
     r.occupancy |= own->direct_occupancy;
-  }
-  if (own != nullptr && own->has_exact) {
+  } else if (own != nullptr && own->has_exact) {
     r.minmax = k::resoct_node_merge_minmax(r.minmax, own->exact_minmax);
     r.occupancy |= own->exact_occupancy;
   }
@@ -130,19 +148,43 @@ struct Scan {
 template <class T>
 Scan scan_box(std::span<const std::byte> voxels, const glm::i64vec3& padded_lo,
               const glm::i64vec3& padded_dim, const Box3& box, const ValueRange& range) {
+  // Row by row: the row's min and max first (a loop the compiler vectorizes); occupancy bins are
+  // monotonic in the value, so a row whose extremes share a bin occupies just that one, and only
+  // rows spanning several bins pay per-voxel bins. The renderer scans every level-0 brick it
+  // uploads, so this runs on the frame thread (bench_octree BM_OctreeMetadataFromBrick).
+  constexpr bool is_float = std::is_floating_point_v<T>;
+  const T none_lo = is_float ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
+  const T none_hi =
+      is_float ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
+  const std::int64_t n = box.hi.x - box.lo.x;
   Scan s;
   for (std::int64_t z = box.lo.z; z < box.hi.z; ++z) {
     for (std::int64_t y = box.lo.y; y < box.hi.y; ++y) {
-      const std::int64_t row =
-          (y - padded_lo.y + padded_dim.y * (z - padded_lo.z)) * padded_dim.x - padded_lo.x;
-      for (std::int64_t x = box.lo.x; x < box.hi.x; ++x) {
+      const std::byte* row =
+          voxels.data() +
+          std::size_t((y - padded_lo.y + padded_dim.y * (z - padded_lo.z)) * padded_dim.x +
+                      box.lo.x - padded_lo.x) *
+              sizeof(T);
+      T lo = none_lo, hi = none_hi;
+      for (std::int64_t x = 0; x < n; ++x) {
         T t;
-        std::memcpy(&t, voxels.data() + std::size_t(row + x) * sizeof(T), sizeof(T));
-        const double v = double(t);
-        if (std::isnan(v)) continue;
-        s.min = std::min(s.min, v);
-        s.max = std::max(s.max, v);
-        s.occupancy |= occupancy_bit(v, range);
+        std::memcpy(&t, row + std::size_t(x) * sizeof(T), sizeof(T));
+        // NaN compares false both ways and is skipped.
+        lo = t < lo ? t : lo;
+        hi = t > hi ? t : hi;
+      }
+      if (!(lo <= hi)) continue;  // only NaN
+      s.min = std::min(s.min, double(lo));
+      s.max = std::max(s.max, double(hi));
+      const std::uint32_t a = occupancy_bit(double(lo), range);
+      if (a == occupancy_bit(double(hi), range)) {
+        s.occupancy |= a;
+        continue;
+      }
+      for (std::int64_t x = 0; x < n; ++x) {
+        T t;
+        std::memcpy(&t, row + std::size_t(x) * sizeof(T), sizeof(T));
+        s.occupancy |= occupancy_bit(double(t), range);  // 0 for NaN
       }
     }
   }
@@ -182,9 +224,17 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
 
   const NodeCoordRange range = layout_.node_range(d, box0);
   const ValueRange& vr = ranges_[slot];
+  // Level 0: a leaf's metadata covers its sampling support (the leaf grown by one voxel, what a
+  // trilinear sample inside it reads; OctreeLayout::sampling_support), which the brick's halo
+  // holds for the leaves of its core when the halo is at least one voxel.
+  const glm::i64vec3 halo(hierarchy_.layout().halo);
+  const Box3 padded0 = intersect(Box3{box0.lo - halo, box0.hi + halo},
+                                 Box3{glm::i64vec3(0), glm::i64vec3(layout_.extent0())});
   layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
     const Box3 nb = layout_.node_box(d, c);
     if (nb.empty() || intersect(nb, box0) != nb) return;  // only nodes the brick fully covers
+    const Box3 support = level == 0 ? layout_.sampling_support(node) : Box3{};
+    if (level == 0 && intersect(support, padded0) != support) return;  // halo too thin
     if (level > 0) {
       const auto it = own_.find(node * slots_ + slot);
       const OwnMeta* had = it == own_.end() ? nullptr : &it->second;
@@ -194,7 +244,8 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
       }
     }
     OwnMeta& o = own(node, slot);
-    const Box3 lv = intersect(hierarchy_.level_box_from_level0(level, nb), core);
+    const Box3 lv =
+        level == 0 ? support : intersect(hierarchy_.level_box_from_level0(level, nb), core);
     Scan s;
     switch (type) {
       case VoxelType::u8: s = scan_box<std::uint8_t>(voxels, padded_lo, padded_dim, lv, vr); break;

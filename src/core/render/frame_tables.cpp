@@ -392,6 +392,9 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   }
 
   out.depths.clear();
+  // Local index bits per axis: a child's local index is the parent's shifted by child_shift, with
+  // the child bits x, then y, then z (x least significant) of the split axes below.
+  glm::uvec3 axis_bits(0u);
   for (std::uint32_t d = 0; d < layout.depth_count(); ++d) {
     const OctreeDepth& od = layout.depth(d);
     kernel::ResoctDepthInfo D{};
@@ -412,6 +415,16 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     D.count_log2_x = od.count_log2.x;
     D.count_log2_y = od.count_log2.y;
     D.count_log2_z = od.count_log2.z;
+    if (d > 0) {
+      std::uint32_t bit = 0;
+      for (int a = 0; a < 3; ++a) {
+        axis_bits[a] <<= od.child_shift;
+        if (od.split[a] != 0u) axis_bits[a] |= 1u << bit++;
+      }
+    }
+    D.axis_bits_x = axis_bits.x;
+    D.axis_bits_y = axis_bits.y;
+    D.axis_bits_z = axis_bits.z;
     out.depths.push_back(D);
   }
 }

@@ -243,7 +243,7 @@ class VolumeFixture : public ::testing::Test {
   // A VALID record bounds the clamped true values and covers their occupancy bins.
   void expect_valid_bounds(const ResidencyOctree& tree, std::uint64_t node, bool exact) const {
     const ValueRange r{0.0, 1.0};
-    const RegionMeta t = truth(tree.layout().node_box(node));
+    const RegionMeta t = truth(tree.layout().sampling_support(node));
     const std::uint32_t mm = tree.word(node, 0, k::RESOCT_NODE_MINMAX);
     const std::uint32_t occ = tree.word(node, 0, k::RESOCT_NODE_OCCUPANCY);
     ASSERT_EQ(occ & t.occupancy, t.occupancy) << "node " << node;
@@ -296,7 +296,7 @@ TEST_F(VolumeFixture, RegionMetadataStaysConservativeUpTheTree) {
     std::uint64_t node = rng() % layout.node_count();
     while (layout.node_box(node).empty()) node = rng() % layout.node_count();
     supplied.insert(node);
-    const Box3 box = layout.node_box(node);
+    const Box3 box = layout.sampling_support(node);  // what the renderer queries
     RegionMeta m = truth(box);
     if (i % 3 == 0 && m.min <= m.max) {  // a looser but still conservative answer
       m.min -= 0.1;
@@ -339,6 +339,44 @@ TEST_F(VolumeFixture, ParentBecomesValidWhenAllChildrenAreKnown) {
   // A narrower answer for the parent itself never narrows it below its children.
   tree.node_metadata(0, parent, RegionMeta{0.5, 0.5, occupancy_bit(0.5, ValueRange{0.0, 1.0})});
   EXPECT_EQ(tree.word(parent, 0, k::RESOCT_NODE_MINMAX), mm);
+}
+
+// A source's region answer is conservative but may be much wider than the data (metadata blocks
+// coarser than the leaves); once a level-0 brick is resident, its leaves hold the intersection
+// with the scan of their sampling support: exactly the data's range, never narrower.
+TEST_F(VolumeFixture, Level0BricksTightenWideRegionAnswers) {
+  ResidencyOctree tree(hierarchy_, OctreeLayout(kExtent, {4, 4, 4}), 1, nothing_resident_);
+  const OctreeLayout& layout = tree.layout();
+  const std::uint32_t leaf = layout.leaf_depth();
+  const ValueRange r{0.0, 1.0};
+  const RegionMeta wide{0.0, 1.0, occupancy_span(0.0, 1.0, r)};
+  std::vector<std::uint64_t> leaves;
+  for (std::uint64_t node = layout.depth(leaf).first_node; node < layout.node_count(); ++node) {
+    if (layout.node_box(node).empty()) continue;
+    tree.node_metadata(0, node, wide);
+    leaves.push_back(node);
+  }
+  ASSERT_FALSE(leaves.empty());
+  EXPECT_EQ(tree.word(leaves[0], 0, k::RESOCT_NODE_MINMAX), octree_pack_range(0.0, 1.0, r));
+  const glm::uvec3 n = hierarchy_.level(0).bricks;
+  for (std::uint32_t z = 0; z < n.z; ++z)
+    for (std::uint32_t y = 0; y < n.y; ++y)
+      for (std::uint32_t x = 0; x < n.x; ++x) {
+        tree.metadata_from_brick(0, 0, {x, y, z}, level0_brick({x, y, z}));
+      }
+  std::size_t tighter = 0;
+  for (std::uint64_t node : leaves) {
+    ASSERT_EQ(state(tree, node), k::RESOCT_NODE_VALID) << "node " << node;
+    expect_valid_bounds(tree, node, /*exact=*/true);
+    if (tree.word(node, 0, k::RESOCT_NODE_MINMAX) != octree_pack_range(0.0, 1.0, r)) ++tighter;
+  }
+  EXPECT_GT(tighter, 0u);  // (exactness per leaf is checked above)
+  // A later region answer for a leaf keeps the intersection (it does not widen the record).
+  const std::uint32_t before = tree.word(leaves[0], 0, k::RESOCT_NODE_MINMAX);
+  tree.node_metadata(0, leaves[0], wide);
+  EXPECT_EQ(tree.word(leaves[0], 0, k::RESOCT_NODE_MINMAX), before);
+  const auto problem = tree.check_invariants();
+  EXPECT_FALSE(problem.has_value()) << *problem;
 }
 
 TEST_F(VolumeFixture, CoarseEstimatesAreApproximateAndYieldToFinerData) {

@@ -20,14 +20,14 @@ namespace {
 namespace k = resoct::kernel;
 
 TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
-  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 2u)
+  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 3u)
       << "the layout version changed: update the table of this test to the new layout";
   const char* bump = "a shared record changed: increment RESOCT_KERNEL_LAYOUT_VERSION";
   EXPECT_EQ(sizeof(k::ResoctFrame), 512u) << bump;
   EXPECT_EQ(sizeof(k::ResoctFxFrame), 44u) << bump;
   EXPECT_EQ(sizeof(k::ResoctSlotInfo), 64u) << bump;
   EXPECT_EQ(sizeof(k::ResoctLevelInfo), 40u) << bump;
-  EXPECT_EQ(sizeof(k::ResoctDepthInfo), 56u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctDepthInfo), 68u) << bump;
   EXPECT_EQ(sizeof(k::ResoctRayStats), 40u) << bump;
   EXPECT_EQ(sizeof(PageDelta), 8u) << bump;
   EXPECT_EQ(sizeof(OctreeWordDelta), 8u) << bump;

@@ -50,6 +50,56 @@ TEST(Renderer, UploadsStayWithinTheBrickBudgetAndStateMatchesTheSource) {
   EXPECT_EQ(again.stats.working_set_bytes, varying * slot_bytes(*rig.renderer));
 }
 
+// Region answers as wide as the value range: conservative but useless for culling, as a coarse
+// metadata pyramid gives around sharp features.
+class WideRegionSource : public BrickSource {
+ public:
+  explicit WideRegionSource(std::shared_ptr<const BrickSource> inner) : inner_(std::move(inner)) {}
+  const BrickHierarchy& hierarchy() const override { return inner_->hierarchy(); }
+  void read_brick(BrickKey key, std::span<std::byte> out) const override {
+    inner_->read_brick(key, out);
+  }
+  BrickMeta brick_meta(BrickKey key) const override { return inner_->brick_meta(key); }
+  RegionMeta region_meta(std::uint32_t c, const Box3&) const override {
+    const ValueRange r = hierarchy().volume().range(c);
+    return RegionMeta{r.lo, r.hi, occupancy_span(r.lo, r.hi, r)};
+  }
+  std::string name() const override { return "wide-region-source"; }
+
+ private:
+  std::shared_ptr<const BrickSource> inner_;
+};
+
+// Each uploaded level-0 brick gives the leaves inside it the exact metadata of their sampling
+// support (ResidencyOctree::metadata_from_brick), however wide the source's region answers.
+TEST(Renderer, UploadedLevel0BricksGiveTheirLeavesExactMetadata) {
+  auto inner = make_test_source(1);
+  auto src = std::make_shared<WideRegionSource>(inner);
+  Rig rig(src, test_options(256, 256));
+  ASSERT_TRUE(rig.renderer->render_until_converged(test_scene(0), 50).converged);
+  const OctreeLayout& layout = inspect::layout(*rig.renderer);
+  const BrickHierarchy& h = rig.renderer->hierarchy();
+  const ValueRange range = h.volume().range(0);
+  const ResidencyOctree& octree = inspect::octree(*rig.renderer);
+  const std::uint32_t leaf = layout.leaf_depth();
+  std::size_t checked = 0;
+  for (std::uint64_t node = layout.depth(leaf).first_node; node < layout.node_count(); ++node) {
+    const Box3 box = layout.node_box(node);
+    if (box.empty()) continue;
+    const glm::uvec3 brick(glm::u64vec3(box.lo) / glm::u64vec3(h.layout().brick_size));
+    if (src->brick_meta(BrickKey(0, 0, brick)).constant) continue;  // mapped without voxels
+    const RegionMeta truth = inner->region_meta(0, layout.sampling_support(node));
+    EXPECT_EQ(octree.word(node, 0, kernel::RESOCT_NODE_MINMAX),
+              octree_pack_range(truth.min, truth.max, range))
+        << "leaf " << node;
+    EXPECT_EQ(octree.word(node, 0, kernel::RESOCT_NODE_OCCUPANCY), truth.occupancy)
+        << "leaf " << node;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0u);
+  EXPECT_EQ(check_state(*rig.renderer, *rig.backend, *src), "");
+}
+
 TEST(Renderer, ConstantBricksMapWithoutCacheSlots) {
   auto src = make_test_source();
   Rig rig(src, test_options(256, 256));
