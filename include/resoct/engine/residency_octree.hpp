@@ -124,6 +124,10 @@ class ResidencyOctree {
   /// Throws Error naming "voxels" for a wrong buffer size, or Error(out_of_range).
   void metadata_from_brick(std::uint32_t slot, std::uint32_t level, glm::uvec3 brick,
                            std::span<const std::byte> voxels);
+  /// metadata_from_brick for a constant level-0 brick (BrickMeta::constant over its padded
+  /// voxels, which the loader does not keep): its leaves get the exact record of that one value.
+  /// Throws Error naming "meta" for a brick that is not constant, or Error(out_of_range).
+  void metadata_from_constant_brick(std::uint32_t slot, glm::uvec3 brick, const BrickMeta& meta);
 
   /// Device-ready storage: node-major records of 4 words (kernel/octree_node.glsl.h).
   std::span<const std::uint32_t> words() const noexcept { return words_; }
@@ -163,6 +167,9 @@ class ResidencyOctree {
   void set_word(std::size_t index, std::uint32_t value);
   void check_slot(std::uint32_t slot) const;
   void check_brick(std::uint32_t level, glm::uvec3 brick) const;
+  /// The sampling support of a leaf of a level-0 brick's core when the padded brick holds it,
+  /// else an empty box.
+  Box3 exact_support(glm::uvec3 brick, std::uint64_t leaf) const;
   bool other_brick_resident(std::uint32_t slot, std::uint32_t level, glm::uvec3 evicted,
                             const Box3& leaf_box);
   /// The metadata rule: a record from the node's own data and its children's stored records.

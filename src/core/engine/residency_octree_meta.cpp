@@ -49,6 +49,7 @@ ResidencyOctree::Record ResidencyOctree::compute_record(
 
   // Children always contribute their values, whatever their state, so that a parent is never
   // narrower than a child; only their states decide whether the union is complete.
+  Record children;
   std::uint32_t non_empty = 0;
   bool all_valid = true;
   bool all_known = true;
@@ -72,8 +73,9 @@ ResidencyOctree::Record ResidencyOctree::compute_record(
       if (empty) continue;
       ++non_empty;
       const std::size_t b = base(first + kid, slot);
-      r.minmax = k::resoct_node_merge_minmax(r.minmax, storage[b + k::RESOCT_NODE_MINMAX]);
-      r.occupancy |= storage[b + k::RESOCT_NODE_OCCUPANCY];
+      children.minmax =
+          k::resoct_node_merge_minmax(children.minmax, storage[b + k::RESOCT_NODE_MINMAX]);
+      children.occupancy |= storage[b + k::RESOCT_NODE_OCCUPANCY];
       const std::uint32_t flags = storage[b + k::RESOCT_NODE_FLAGS];
       const std::uint32_t st = k::resoct_node_state(flags);
       all_valid = all_valid && st == k::RESOCT_NODE_VALID;
@@ -85,6 +87,16 @@ ResidencyOctree::Record ResidencyOctree::compute_record(
   }
   all_valid = all_valid && non_empty > 0;
   all_known = all_known && non_empty > 0;
+  if (all_valid) {
+    // The children's supports cover the node's, so their union alone bounds its values; the
+    // node's own answer could only widen it (a source answers a large region from coarse
+    // metadata blocks, while the leaves below may hold exact scans of their bricks).
+    r.minmax = children.minmax;
+    r.occupancy = children.occupancy;
+  } else {
+    r.minmax = k::resoct_node_merge_minmax(r.minmax, children.minmax);
+    r.occupancy |= children.occupancy;
+  }
 
   if (own_conservative || all_valid) {
     r.flags = k::resoct_node_make_flags(k::RESOCT_NODE_VALID, 0u);
@@ -193,6 +205,42 @@ Scan scan_box(std::span<const std::byte> voxels, const glm::i64vec3& padded_lo,
 
 }  // namespace
 
+Box3 ResidencyOctree::exact_support(glm::uvec3 brick, std::uint64_t leaf) const {
+  // A leaf's metadata covers its sampling support (the leaf grown by one voxel, what a trilinear
+  // sample inside it reads; OctreeLayout::sampling_support), which the padded level-0 brick holds
+  // for the leaves of its core when the halo is at least one voxel.
+  const Box3 box0 = hierarchy_.level0_box(0, brick);
+  const glm::i64vec3 halo(hierarchy_.layout().halo);
+  const Box3 padded0 = intersect(Box3{box0.lo - halo, box0.hi + halo},
+                                 Box3{glm::i64vec3(0), glm::i64vec3(layout_.extent0())});
+  const Box3 support = layout_.sampling_support(leaf);
+  return intersect(support, padded0) == support ? support : Box3{};
+}
+
+void ResidencyOctree::metadata_from_constant_brick(std::uint32_t slot, glm::uvec3 brick,
+                                                   const BrickMeta& meta) {
+  check_slot(slot);
+  check_brick(0, brick);
+  if (!meta.constant) throw invalid_parameter("meta", "the brick is not constant");
+  const ValueRange& vr = ranges_[slot];
+  // Every finite voxel of the padded brick has the one value (or there is none).
+  const std::uint32_t mm = octree_pack_range(meta.min, meta.max, vr);
+  const std::uint32_t occupancy = meta.min <= meta.max ? occupancy_bit(meta.min, vr) : 0u;
+  const Box3 box0 = hierarchy_.level0_box(0, brick);
+  const std::uint32_t d = layout_.leaf_depth();
+  const NodeCoordRange range = layout_.node_range(d, box0);
+  layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
+    const Box3 nb = layout_.node_box(d, c);
+    if (nb.empty() || intersect(nb, box0) != nb || exact_support(brick, node).empty()) return;
+    OwnMeta& o = own(node, slot);
+    o.has_exact = true;
+    o.exact_minmax = mm;
+    o.exact_occupancy = occupancy;
+    o.has_approx = false;
+  });
+  if (!range.empty()) propagate_metadata(slot, d, range);
+}
+
 void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t level, glm::uvec3 brick,
                                           std::span<const std::byte> voxels) {
   check_slot(slot);
@@ -224,17 +272,11 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
 
   const NodeCoordRange range = layout_.node_range(d, box0);
   const ValueRange& vr = ranges_[slot];
-  // Level 0: a leaf's metadata covers its sampling support (the leaf grown by one voxel, what a
-  // trilinear sample inside it reads; OctreeLayout::sampling_support), which the brick's halo
-  // holds for the leaves of its core when the halo is at least one voxel.
-  const glm::i64vec3 halo(hierarchy_.layout().halo);
-  const Box3 padded0 = intersect(Box3{box0.lo - halo, box0.hi + halo},
-                                 Box3{glm::i64vec3(0), glm::i64vec3(layout_.extent0())});
   layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
     const Box3 nb = layout_.node_box(d, c);
     if (nb.empty() || intersect(nb, box0) != nb) return;  // only nodes the brick fully covers
-    const Box3 support = level == 0 ? layout_.sampling_support(node) : Box3{};
-    if (level == 0 && intersect(support, padded0) != support) return;  // halo too thin
+    const Box3 support = level == 0 ? exact_support(brick, node) : Box3{};
+    if (level == 0 && support.empty()) return;
     if (level > 0) {
       const auto it = own_.find(node * slots_ + slot);
       const OwnMeta* had = it == own_.end() ? nullptr : &it->second;

@@ -148,6 +148,7 @@ bool Renderer::Impl::apply_one(const LoadedBrick& b, FrameStats& stats) {
       ++stats.pages_homogeneous;
     }
     octree_->brick_added(addr.slot, addr.level, addr.brick);
+    if (addr.level == 0) octree_->metadata_from_constant_brick(addr.slot, addr.brick, hb.meta);
     return true;
   }
   const auto ins = cache_->insert(hb.key);

@@ -318,6 +318,10 @@ TEST(ResidencyOctree, RejectsBadArguments) {
   const std::vector<std::byte> short_buf(10);
   EXPECT_RESOCT_ERROR(tree.metadata_from_brick(0, 0, {0, 0, 0}, short_buf),
                       ErrorCode::invalid_argument, "voxels");
+  EXPECT_RESOCT_ERROR(tree.metadata_from_constant_brick(0, {0, 0, 0}, BrickMeta{0.1, 0.2, false}),
+                      ErrorCode::invalid_argument, "meta");
+  EXPECT_RESOCT_ERROR(tree.metadata_from_constant_brick(0, {8, 0, 0}, BrickMeta{0.1, 0.1, true}),
+                      ErrorCode::out_of_range, "brick");
 }
 
 }  // namespace
