@@ -6,6 +6,9 @@
 //   BM_OctreeAdd/..., BM_OctreeEvict/...      the two halves separately, in batches of distinct
 //                                             bricks (the other half paused)
 //   BM_OctreeMetadataFromBrick/<leaf>/<smooth> exact leaf metadata from one level-0 brick
+//   BM_OctreeLeafMetadata/<leaf>               storing a level-0 brick's leaf records scanned
+//                                             elsewhere (the frame thread's share since the
+//                                             loader threads scan, scan_leaves)
 // ns_per_brick is CPU time per item (per add+evict pair, or per add / per evict); Google Benchmark
 // prints inverted rates with an "s" suffix, so "907.6s" there means 907.6 ns.
 //
@@ -23,6 +26,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "resoct/engine/leaf_scan.hpp"
 #include "resoct/engine/residency_octree.hpp"
 
 namespace {
@@ -209,10 +213,43 @@ void BM_OctreeMetadataFromBrick(benchmark::State& state) {
       double(state.iterations()) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+// What the renderer's frame thread still does per level-0 upload now that the loader threads
+// scan the brick (scan_leaves, outside the timed loop): store the records and propagate them.
+void BM_OctreeLeafMetadata(benchmark::State& state) {
+  const auto leaf = std::uint32_t(state.range(0));
+  Setup setup(1);
+  const OctreeLayout layout{glm::u64vec3(extent()), glm::uvec3(leaf)};
+  ResidencyOctree tree(setup.hierarchy, layout, 1, setup.query());
+  std::vector<std::byte> voxels(setup.hierarchy.layout().padded_voxels() * 2);
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < voxels.size(); i += 2) {
+    const auto v = std::uint16_t(rng() & 0xffffu);
+    std::memcpy(voxels.data() + i, &v, 2);
+  }
+  const glm::uvec3 n = setup.hierarchy.level(0).bricks;
+  constexpr std::uint64_t kBricks = 256;  // one upload budget's worth, stored in turn
+  std::vector<glm::uvec3> bricks;
+  std::vector<std::vector<LeafScan>> scans;
+  for (std::uint64_t i = 0; i < kBricks; ++i) {
+    const glm::uvec3 b(std::uint32_t(i % n.x), std::uint32_t((i / n.x) % n.y),
+                       std::uint32_t((i / n.x / n.y) % n.z));
+    bricks.push_back(b);
+    scans.push_back(scan_leaves(layout, setup.hierarchy, default_range(VoxelType::u16), b, voxels));
+  }
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    tree.leaf_metadata(0, bricks[i % kBricks], scans[i % kBricks]);
+    if (++i % 1024 == 0) benchmark::DoNotOptimize(tree.take_deltas());
+  }
+  state.counters["ns_per_brick"] = benchmark::Counter(
+      double(state.iterations()) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 BENCHMARK(BM_OctreeAddEvict)->Apply(depth_and_slots);
 BENCHMARK(BM_OctreeMetadataFromBrick)
     ->ArgsProduct({{8, 16, 32}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_OctreeLeafMetadata)->Arg(8)->Arg(16)->Arg(32)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_OctreeAdd)->Args({16, 4, 0})->Args({16, 4, 2})->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_OctreeEvict)->Args({16, 4, 0})->Args({16, 4, 2})->Unit(benchmark::kNanosecond);
 

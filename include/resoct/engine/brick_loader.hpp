@@ -18,11 +18,15 @@
 #include <unordered_set>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "resoct/volume/brick_key.hpp"
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/cache/eviction_policy.hpp"
 #include "resoct/cache/host_brick_cache.hpp"
+#include "resoct/engine/leaf_scan.hpp"
 #include "resoct/engine/load_failure.hpp"
+#include "resoct/engine/octree_layout.hpp"
 #include "resoct/volume/timed_brick_key.hpp"
 #include "resoct/sources/timepoint_sources.hpp"
 
@@ -45,6 +49,11 @@ struct LoadedBrick {
   std::uint32_t hits = 0;
   std::uint64_t since = 0;
   std::uint32_t rank = 0;
+  /// A level-0 brick's exact leaf records (scan_leaves over its voxels), computed on the loading
+  /// thread for the octree whose leaves are `leaf_size` voxels (BrickLoader's `leaf_layout`);
+  /// leaf_size 0: not computed (constant bricks, level > 0, no layout).
+  std::vector<LeafScan> leaves;
+  glm::uvec3 leaf_size{0};
   LoadRequest request() const { return {brick->key, hits, since, rank}; }
 };
 
@@ -85,10 +94,13 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept;
 class BrickLoader {
  public:
   /// Throws Error(invalid_argument) naming "source" when it is null or "threads" above 1024.
-  /// `host_policy` orders host cache evictions (null: LRU).
+  /// `host_policy` orders host cache evictions (null: LRU). With a `leaf_layout` (the residency
+  /// octree's), every level-0 brick that is not constant is delivered with its leaves' exact
+  /// records (LoadedBrick::leaves, scan_leaves over the channel's range), computed on the loading
+  /// thread so that the frame thread only stores them.
   BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
-              std::uint64_t host_cache_bytes,
-              std::unique_ptr<EvictionPolicy> host_policy = nullptr);
+              std::uint64_t host_cache_bytes, std::unique_ptr<EvictionPolicy> host_policy = nullptr,
+              std::shared_ptr<const OctreeLayout> leaf_layout = nullptr);
   /// Stops the workers after their current brick; queued requests are dropped.
   ~BrickLoader();
   BrickLoader(const BrickLoader&) = delete;
@@ -184,6 +196,9 @@ class BrickLoader {
   /// `transient` and retries are on, and reports it unless it was reported before. Caller holds
   /// mutex_.
   void fail_locked(BrickKey key, std::string failure, bool transient);
+  /// The delivery of `brick` for request `r`, with its leaves' records where they apply
+  /// (scanned by the calling thread; call without mutex_).
+  LoadedBrick deliver(std::shared_ptr<const HostBrick> brick, const LoadRequest& r) const;
   /// Lets the failed keys whose retry is due through again. Caller holds mutex_.
   void release_due_retries_locked();
   /// When a failed key may be loaded again, and how often it failed.
@@ -193,7 +208,8 @@ class BrickLoader {
   };
 
   std::shared_ptr<TimepointSources> sources_;
-  std::shared_ptr<const BrickSource> current_;  // source of timepoint_
+  std::shared_ptr<const OctreeLayout> leaf_layout_;  // set once, before the workers start
+  std::shared_ptr<const BrickSource> current_;       // source of timepoint_
   std::uint32_t timepoint_ = 0;
   // Bumped by every switch: a job of an older generation is stale when it completes.
   std::uint64_t generation_ = 0;

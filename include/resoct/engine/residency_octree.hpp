@@ -16,6 +16,7 @@
 #include <glm/vec3.hpp>
 
 #include "resoct/engine/device_records.hpp"
+#include "resoct/engine/leaf_scan.hpp"
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/engine/octree_layout.hpp"
@@ -128,6 +129,12 @@ class ResidencyOctree {
   /// voxels, which the loader does not keep): its leaves get the exact record of that one value.
   /// Throws Error naming "meta" for a brick that is not constant, or Error(out_of_range).
   void metadata_from_constant_brick(std::uint32_t slot, glm::uvec3 brick, const BrickMeta& meta);
+  /// Exact (VALID) leaf records computed elsewhere from level-0 brick `brick` (scan_leaves or
+  /// scan_constant_leaves with this octree's layout and the slot's range, e.g. on a loader
+  /// thread): stored as metadata_from_brick stores its own scan, then ancestors are updated.
+  /// Throws Error(out_of_range) for a bad slot or brick, or a record whose node is not a leaf
+  /// of that brick (nothing is stored then).
+  void leaf_metadata(std::uint32_t slot, glm::uvec3 brick, std::span<const LeafScan> leaves);
 
   /// Device-ready storage: node-major records of 4 words (kernel/octree_node.glsl.h).
   std::span<const std::uint32_t> words() const noexcept { return words_; }
@@ -169,7 +176,6 @@ class ResidencyOctree {
   void check_brick(std::uint32_t level, glm::uvec3 brick) const;
   /// The sampling support of a leaf of a level-0 brick's core when the padded brick holds it,
   /// else an empty box.
-  Box3 exact_support(glm::uvec3 brick, std::uint64_t leaf) const;
   bool other_brick_resident(std::uint32_t slot, std::uint32_t level, glm::uvec3 evicted,
                             const Box3& leaf_box);
   /// The metadata rule: a record from the node's own data and its children's stored records.

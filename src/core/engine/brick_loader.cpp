@@ -19,8 +19,9 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept {
 
 BrickLoader::BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
                          std::uint64_t host_cache_bytes,
-                         std::unique_ptr<EvictionPolicy> host_policy)
-    : cache_(host_cache_bytes, std::move(host_policy)) {
+                         std::unique_ptr<EvictionPolicy> host_policy,
+                         std::shared_ptr<const OctreeLayout> leaf_layout)
+    : leaf_layout_(std::move(leaf_layout)), cache_(host_cache_bytes, std::move(host_policy)) {
   if (!source) throw invalid_parameter("source", "must not be null");
   sources_ = std::make_shared<TimepointSources>(std::move(source));
   current_ = sources_->series();
@@ -263,6 +264,19 @@ void BrickLoader::prefetch_one(const TimedBrickKey& key) {
     failure = sources_->series()->name() + ": timepoint " + std::to_string(key.timepoint) + ": " +
               e.what();
   }
+  // A prefetched brick requested meanwhile is delivered with its leaves' records, scanned here
+  // outside the lock; an adoption that arrives after this look is delivered without them (the
+  // renderer then scans on its own thread).
+  std::optional<LoadedBrick> scanned;
+  if (result && leaf_layout_) {
+    std::optional<LoadRequest> wanted;
+    {
+      std::lock_guard lock(mutex_);
+      const auto a = key.timepoint == timepoint_ ? adopted_.find(key.key) : adopted_.end();
+      if (a != adopted_.end()) wanted = a->second;
+    }
+    if (wanted) scanned = deliver(result, *wanted);
+  }
   {
     std::lock_guard lock(mutex_);
     prefetching_.erase(key);
@@ -271,7 +285,11 @@ void BrickLoader::prefetch_one(const TimedBrickKey& key) {
     if (result) {
       if (adopted != adopted_.end()) {
         const LoadRequest& r = adopted->second;
-        ready_[key.key] = LoadedBrick{result, r.hits, r.since, r.rank};
+        LoadedBrick d = scanned ? std::move(*scanned) : LoadedBrick{result};
+        d.hits = r.hits;
+        d.since = r.since;
+        d.rank = r.rank;
+        ready_[key.key] = std::move(d);
         ++stats_.prefetch_hits;
       } else {
         prefetched_.insert(key);
@@ -286,6 +304,20 @@ void BrickLoader::prefetch_one(const TimedBrickKey& key) {
   idle_cv_.notify_all();
 }
 
+LoadedBrick BrickLoader::deliver(std::shared_ptr<const HostBrick> brick,
+                                 const LoadRequest& r) const {
+  LoadedBrick out{std::move(brick), r.hits, r.since, r.rank};
+  const HostBrick& b = *out.brick;
+  if (leaf_layout_ && b.key.level() == 0 && !b.meta.constant) {
+    // The series' range, as the renderer gives the octree slot (ResidencyOctree::remap_slot).
+    const BrickSource& series = *sources_->series();
+    out.leaves = scan_leaves(*leaf_layout_, series.hierarchy(),
+                             series.volume().range(b.key.channel()), b.key.brick(), b.voxels);
+    out.leaf_size = leaf_layout_->leaf_size();
+  }
+  return out;
+}
+
 void BrickLoader::load_one(const Job& job) {
   const LoadRequest& r = job.request;
   std::shared_ptr<const HostBrick> result = cache_.get(r.key, job.timepoint);
@@ -293,6 +325,9 @@ void BrickLoader::load_one(const Job& job) {
   std::string failure;
   bool transient = false;
   if (!result) result = read_brick(*job.source, r.key, job.timepoint, failure, transient);
+  // The leaves' records are computed here, outside the lock, also for a host cache hit.
+  std::optional<LoadedBrick> loaded;
+  if (result) loaded = deliver(result, r);
   {
     std::lock_guard lock(mutex_);
     if (job.generation != generation_) {
@@ -308,8 +343,8 @@ void BrickLoader::load_one(const Job& job) {
     if (prefetched_.erase(TimedBrickKey{r.key, job.timepoint}) && from_cache) {
       ++stats_.prefetch_hits;
     }
-    if (result) {
-      ready_[r.key] = LoadedBrick{result, r.hits, r.since, r.rank};
+    if (loaded) {
+      ready_[r.key] = std::move(*loaded);
       ++(from_cache ? stats_.host_hits : stats_.loads);
       retry_.erase(r.key);
     } else {

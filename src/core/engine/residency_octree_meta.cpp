@@ -9,6 +9,7 @@
 
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/engine/leaf_scan.hpp"
 #include "resoct/engine/residency_octree.hpp"
 
 namespace resoct {
@@ -149,102 +150,50 @@ void ResidencyOctree::node_metadata(std::uint32_t slot, std::uint64_t node,
   propagate_metadata(slot, d, NodeCoordRange{c, c + 1u});
 }
 
-namespace {
-
-struct Scan {
-  double min = std::numeric_limits<double>::infinity();
-  double max = -std::numeric_limits<double>::infinity();
-  std::uint32_t occupancy = 0;
-};
-
-template <class T>
-Scan scan_box(std::span<const std::byte> voxels, const glm::i64vec3& padded_lo,
-              const glm::i64vec3& padded_dim, const Box3& box, const ValueRange& range) {
-  // Row by row: the row's min and max first (a loop the compiler vectorizes); occupancy bins are
-  // monotonic in the value, so a row whose extremes share a bin occupies just that one, and only
-  // rows spanning several bins pay per-voxel bins. The renderer scans every level-0 brick it
-  // uploads, so this runs on the frame thread (bench_octree BM_OctreeMetadataFromBrick).
-  constexpr bool is_float = std::is_floating_point_v<T>;
-  const T none_lo = is_float ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
-  const T none_hi =
-      is_float ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
-  const std::int64_t n = box.hi.x - box.lo.x;
-  Scan s;
-  for (std::int64_t z = box.lo.z; z < box.hi.z; ++z) {
-    for (std::int64_t y = box.lo.y; y < box.hi.y; ++y) {
-      const std::byte* row =
-          voxels.data() +
-          std::size_t((y - padded_lo.y + padded_dim.y * (z - padded_lo.z)) * padded_dim.x +
-                      box.lo.x - padded_lo.x) *
-              sizeof(T);
-      T lo = none_lo, hi = none_hi;
-      for (std::int64_t x = 0; x < n; ++x) {
-        T t;
-        std::memcpy(&t, row + std::size_t(x) * sizeof(T), sizeof(T));
-        // NaN compares false both ways and is skipped.
-        lo = t < lo ? t : lo;
-        hi = t > hi ? t : hi;
-      }
-      if (!(lo <= hi)) continue;  // only NaN
-      s.min = std::min(s.min, double(lo));
-      s.max = std::max(s.max, double(hi));
-      const std::uint32_t a = occupancy_bit(double(lo), range);
-      if (a == occupancy_bit(double(hi), range)) {
-        s.occupancy |= a;
-        continue;
-      }
-      for (std::int64_t x = 0; x < n; ++x) {
-        T t;
-        std::memcpy(&t, row + std::size_t(x) * sizeof(T), sizeof(T));
-        s.occupancy |= occupancy_bit(double(t), range);  // 0 for NaN
-      }
+void ResidencyOctree::leaf_metadata(std::uint32_t slot, glm::uvec3 brick,
+                                    std::span<const LeafScan> leaves) {
+  check_slot(slot);
+  check_brick(0, brick);
+  const std::uint32_t d = layout_.leaf_depth();
+  const NodeCoordRange range = layout_.node_range(d, hierarchy_.level0_box(0, brick));
+  const std::uint64_t first = layout_.depth(d).first_node;
+  for (const LeafScan& l : leaves) {
+    bool inside = l.leaf >= first && l.leaf < layout_.node_count();
+    if (inside) {
+      const glm::uvec3 c = layout_.node_coord(l.leaf);
+      inside = glm::all(glm::greaterThanEqual(c, range.lo)) && glm::all(glm::lessThan(c, range.hi));
+    }
+    if (!inside) {
+      throw Error(ErrorCode::out_of_range,
+                  "leaf " + std::to_string(l.leaf) + " is not a leaf of level-0 brick (" +
+                      std::to_string(brick.x) + ", " + std::to_string(brick.y) + ", " +
+                      std::to_string(brick.z) + ")");
     }
   }
-  return s;
-}
-
-}  // namespace
-
-Box3 ResidencyOctree::exact_support(glm::uvec3 brick, std::uint64_t leaf) const {
-  // A leaf's metadata covers its sampling support (the leaf grown by one voxel, what a trilinear
-  // sample inside it reads; OctreeLayout::sampling_support), which the padded level-0 brick holds
-  // for the leaves of its core when the halo is at least one voxel.
-  const Box3 box0 = hierarchy_.level0_box(0, brick);
-  const glm::i64vec3 halo(hierarchy_.layout().halo);
-  const Box3 padded0 = intersect(Box3{box0.lo - halo, box0.hi + halo},
-                                 Box3{glm::i64vec3(0), glm::i64vec3(layout_.extent0())});
-  const Box3 support = layout_.sampling_support(leaf);
-  return intersect(support, padded0) == support ? support : Box3{};
+  for (const LeafScan& l : leaves) {
+    OwnMeta& o = own(l.leaf, slot);
+    o.has_exact = true;
+    o.exact_minmax = l.minmax;
+    o.exact_occupancy = l.occupancy;
+    o.has_approx = false;
+  }
+  if (!range.empty()) propagate_metadata(slot, d, range);
 }
 
 void ResidencyOctree::metadata_from_constant_brick(std::uint32_t slot, glm::uvec3 brick,
                                                    const BrickMeta& meta) {
   check_slot(slot);
-  check_brick(0, brick);
-  if (!meta.constant) throw invalid_parameter("meta", "the brick is not constant");
-  const ValueRange& vr = ranges_[slot];
-  // Every finite voxel of the padded brick has the one value (or there is none).
-  const std::uint32_t mm = octree_pack_range(meta.min, meta.max, vr);
-  const std::uint32_t occupancy = meta.min <= meta.max ? occupancy_bit(meta.min, vr) : 0u;
-  const Box3 box0 = hierarchy_.level0_box(0, brick);
-  const std::uint32_t d = layout_.leaf_depth();
-  const NodeCoordRange range = layout_.node_range(d, box0);
-  layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
-    const Box3 nb = layout_.node_box(d, c);
-    if (nb.empty() || intersect(nb, box0) != nb || exact_support(brick, node).empty()) return;
-    OwnMeta& o = own(node, slot);
-    o.has_exact = true;
-    o.exact_minmax = mm;
-    o.exact_occupancy = occupancy;
-    o.has_approx = false;
-  });
-  if (!range.empty()) propagate_metadata(slot, d, range);
+  leaf_metadata(slot, brick, scan_constant_leaves(layout_, hierarchy_, ranges_[slot], brick, meta));
 }
 
 void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t level, glm::uvec3 brick,
                                           std::span<const std::byte> voxels) {
   check_slot(slot);
   check_brick(level, brick);
+  if (level == 0) {
+    leaf_metadata(slot, brick, scan_leaves(layout_, hierarchy_, ranges_[slot], brick, voxels));
+    return;
+  }
   const VoxelType type = hierarchy_.volume().type;
   const std::uint64_t expected = hierarchy_.layout().padded_voxels() * voxel_size(type);
   if (voxels.size() != expected) {
@@ -258,7 +207,7 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
   const glm::uvec3 f = hierarchy_.level(level).factor_log2;
 
   // Nodes finer than one level-l voxel would only repeat that voxel's value: stop at the deepest
-  // depth whose nodes still span a whole voxel (level 0: the leaves).
+  // depth whose nodes still span a whole voxel.
   std::uint32_t d = 0;
   for (std::uint32_t t = 0; t <= layout_.leaf_depth(); ++t) {
     bool fits = true;
@@ -275,39 +224,20 @@ void ResidencyOctree::metadata_from_brick(std::uint32_t slot, std::uint32_t leve
   layout_.for_each_node(d, range, [&](std::uint64_t node, glm::uvec3 c) {
     const Box3 nb = layout_.node_box(d, c);
     if (nb.empty() || intersect(nb, box0) != nb) return;  // only nodes the brick fully covers
-    const Box3 support = level == 0 ? exact_support(brick, node) : Box3{};
-    if (level == 0 && support.empty()) return;
-    if (level > 0) {
-      const auto it = own_.find(node * slots_ + slot);
-      const OwnMeta* had = it == own_.end() ? nullptr : &it->second;
-      if (had != nullptr &&
-          (had->has_direct || had->has_exact || (had->has_approx && had->approx_level < level))) {
-        return;  // an estimate never replaces conservative data or a finer estimate
-      }
+    const auto it = own_.find(node * slots_ + slot);
+    const OwnMeta* had = it == own_.end() ? nullptr : &it->second;
+    if (had != nullptr &&
+        (had->has_direct || had->has_exact || (had->has_approx && had->approx_level < level))) {
+      return;  // an estimate never replaces conservative data or a finer estimate
     }
+    const VoxelBoxScan s =
+        scan_voxel_box(voxels, type, padded_lo, padded_dim,
+                       intersect(hierarchy_.level_box_from_level0(level, nb), core), vr);
     OwnMeta& o = own(node, slot);
-    const Box3 lv =
-        level == 0 ? support : intersect(hierarchy_.level_box_from_level0(level, nb), core);
-    Scan s;
-    switch (type) {
-      case VoxelType::u8: s = scan_box<std::uint8_t>(voxels, padded_lo, padded_dim, lv, vr); break;
-      case VoxelType::u16:
-        s = scan_box<std::uint16_t>(voxels, padded_lo, padded_dim, lv, vr);
-        break;
-      case VoxelType::f32: s = scan_box<float>(voxels, padded_lo, padded_dim, lv, vr); break;
-    }
-    const std::uint32_t mm = octree_pack_range(s.min, s.max, vr);
-    if (level == 0) {
-      o.has_exact = true;
-      o.exact_minmax = mm;
-      o.exact_occupancy = s.occupancy;
-      o.has_approx = false;
-    } else {
-      o.has_approx = true;
-      o.approx_minmax = mm;
-      o.approx_occupancy = s.occupancy;
-      o.approx_level = level;
-    }
+    o.has_approx = true;
+    o.approx_minmax = octree_pack_range(s.min, s.max, vr);
+    o.approx_occupancy = s.occupancy;
+    o.approx_level = level;
   });
   if (!range.empty()) propagate_metadata(slot, d, range);
 }

@@ -163,8 +163,15 @@ bool Renderer::Impl::apply_one(const LoadedBrick& b, FrameStats& stats) {
   pages_.set_mapped(addr, ins->slot);
   octree_->brick_added(addr.slot, addr.level, addr.brick);
   // A level-0 brick's voxels give its leaves exact culling metadata, often much tighter than the
-  // source's region answer (ResidencyOctree::metadata_from_brick).
-  if (addr.level == 0) octree_->metadata_from_brick(addr.slot, 0, addr.brick, hb.voxels);
+  // source's region answer (docs/residency-octree.md §4). The loader scanned them on its thread
+  // (LoadedBrick::leaves); a brick it did not scan for these leaves is scanned here.
+  if (addr.level == 0) {
+    if (b.leaf_size == layout_.leaf_size()) {
+      octree_->leaf_metadata(addr.slot, addr.brick, b.leaves);
+    } else {
+      octree_->metadata_from_brick(addr.slot, 0, addr.brick, hb.voxels);
+    }
+  }
   uploads_.push_back(BrickUpload{ins->slot, hb.voxels});
   upload_data_.push_back(b.brick);
   ++stats.bricks_uploaded;

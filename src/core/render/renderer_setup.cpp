@@ -118,7 +118,8 @@ Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<
       });
   loader_ = std::make_unique<BrickLoader>(
       source_, options_.loader_threads, options_.host_cache_bytes,
-      make_host_policy(options_.host_eviction, hierarchy_, host_camera_));
+      make_host_policy(options_.host_eviction, hierarchy_, host_camera_),
+      std::make_shared<const OctreeLayout>(layout_));
   loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
   timepoint_ = source_->timepoint();
   timepoint_source_ = source_;

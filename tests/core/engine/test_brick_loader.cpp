@@ -130,6 +130,55 @@ TEST(BrickLoader, DeliversVoxelsAndMetadataOfTheSource) {
   EXPECT_GT(constant, 0u);  // x < 12 gives all-zero level-0 bricks
 }
 
+// With the residency octree's layout the loader scans each level-0 brick's leaves on its own
+// threads (LoadedBrick::leaves): the records scan_leaves gives for the voxels it delivers, over the
+// channel's range; level > 0 and constant bricks carry none, and without a layout nothing is
+// scanned.
+TEST(BrickLoader, ScansLevel0LeavesOnItsThreadsWhenGivenTheOctreeLayout) {
+  auto src = std::make_shared<RecordingSource>();
+  const BrickHierarchy& h = src->hierarchy();
+  auto layout = std::make_shared<const OctreeLayout>(h.volume().extent, glm::uvec3(4));
+  BrickLoader loader(src, 2, 1 << 20, nullptr, layout);
+  loader.request(all_requests(h, 4));
+  loader.wait_idle();
+  std::size_t scanned = 0;
+  for (const LoadedBrick& b : loader.take_ready()) {
+    const HostBrick& hb = *b.brick;
+    if (hb.key.level() != 0 || hb.meta.constant) {
+      EXPECT_TRUE(b.leaves.empty());
+      EXPECT_EQ(b.leaf_size, glm::uvec3(0));
+      continue;
+    }
+    ++scanned;
+    EXPECT_EQ(b.leaf_size, glm::uvec3(4));
+    EXPECT_EQ(b.leaves, scan_leaves(*layout, h, h.volume().range(hb.key.channel()), hb.key.brick(),
+                                    hb.voxels));
+    EXPECT_EQ(b.leaves.size(), 8u);  // 8³ bricks, 4³ leaves
+  }
+  EXPECT_GT(scanned, 0u);
+  // Requested again: served by the host cache, and scanned again.
+  loader.request(all_requests(h, 4));
+  loader.wait_idle();
+  std::size_t rescanned = 0;
+  for (const LoadedBrick& b : loader.take_ready()) {
+    if (b.brick->key.level() == 0 && !b.brick->meta.constant) {
+      EXPECT_EQ(b.leaf_size, glm::uvec3(4));
+      EXPECT_EQ(b.leaves.size(), 8u);
+      ++rescanned;
+    }
+  }
+  EXPECT_EQ(rescanned, scanned);
+  EXPECT_EQ(loader.stats().host_hits, loader.stats().loads);
+
+  BrickLoader plain(src, 0, 1 << 20);
+  plain.request(all_requests(h, 4));
+  plain.run_queued(1000);
+  for (const LoadedBrick& b : plain.take_ready()) {
+    EXPECT_TRUE(b.leaves.empty());
+    EXPECT_EQ(b.leaf_size, glm::uvec3(0));
+  }
+}
+
 TEST(BrickLoader, DeduplicatesQueuedReadyAndCachedKeys) {
   auto src = std::make_shared<RecordingSource>();
   BrickLoader loader(src, 0, 1 << 20);

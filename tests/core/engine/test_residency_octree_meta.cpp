@@ -15,7 +15,10 @@
 #include <gtest/gtest.h>
 
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/base/error.hpp"
+#include "resoct/engine/leaf_scan.hpp"
 #include "resoct/engine/residency_octree.hpp"
+#include "support/expect_error.hpp"
 
 namespace resoct {
 namespace {
@@ -257,6 +260,7 @@ class VolumeFixture : public ::testing::Test {
       ASSERT_LT(octree_dequantize(k::resoct_node_max16(mm), r) - 1.0 / 65535.0, clamp_to(t.max, r));
     }
   }
+  glm::uvec3 n_bricks_past() const { return {hierarchy_.level(0).bricks.x, 0, 0}; }
   std::uint32_t state(const ResidencyOctree& tree, std::uint64_t node) const {
     return k::resoct_node_state(tree.word(node, 0, k::RESOCT_NODE_FLAGS));
   }
@@ -417,6 +421,78 @@ TEST_F(VolumeFixture, CoarseEstimatesAreApproximateAndYieldToFinerData) {
   EXPECT_EQ(state(tree, 0), k::RESOCT_NODE_VALID);
   const auto problem = tree.check_invariants();
   EXPECT_FALSE(problem.has_value()) << *problem;
+}
+
+// scan_leaves (what the brick loader computes on its threads) against brute force over each
+// leaf's sampling support, then stored through leaf_metadata: the same tree as the frame-thread
+// scan of metadata_from_brick, whatever order the records arrive in.
+TEST_F(VolumeFixture, LeafScansMatchBruteForceAndStoreLikeBrickScans) {
+  const OctreeLayout layout(kExtent, {4, 4, 4});
+  ResidencyOctree scanned(hierarchy_, layout, 1, nothing_resident_);
+  ResidencyOctree stored(hierarchy_, layout, 1, nothing_resident_);
+  const ValueRange r{0.0, 1.0};
+  std::set<std::uint64_t> seen;
+  std::mt19937 rng(5);
+  const glm::uvec3 n = hierarchy_.level(0).bricks;
+  for (std::uint32_t z = 0; z < n.z; ++z)
+    for (std::uint32_t y = 0; y < n.y; ++y)
+      for (std::uint32_t x = 0; x < n.x; ++x) {
+        const std::vector<std::byte> voxels = level0_brick({x, y, z});
+        std::vector<LeafScan> leaves = scan_leaves(layout, hierarchy_, r, {x, y, z}, voxels);
+        ASSERT_EQ(leaves.size(), 8u) << "8³ bricks hold 2³ leaves of 4³";
+        for (const LeafScan& l : leaves) {
+          EXPECT_TRUE(seen.insert(l.leaf).second) << "leaf " << l.leaf << " scanned twice";
+          const RegionMeta t = truth(layout.sampling_support(l.leaf));
+          EXPECT_EQ(l.minmax, octree_pack_range(t.min, t.max, r)) << "leaf " << l.leaf;
+          EXPECT_EQ(l.occupancy, t.occupancy) << "leaf " << l.leaf;
+        }
+        scanned.metadata_from_brick(0, 0, {x, y, z}, voxels);
+        std::shuffle(leaves.begin(), leaves.end(), rng);
+        stored.leaf_metadata(0, {x, y, z}, leaves);
+      }
+  std::size_t in_volume = 0;  // the padded tree's leaves past the far border hold nothing
+  for (std::uint64_t l = layout.depth(layout.leaf_depth()).first_node; l < layout.node_count();
+       ++l) {
+    if (!layout.node_box(l).empty()) ++in_volume;
+  }
+  EXPECT_EQ(seen.size(), in_volume);
+  EXPECT_TRUE(std::equal(scanned.words().begin(), scanned.words().end(), stored.words().begin(),
+                         stored.words().end()));
+  const auto problem = stored.check_invariants();
+  EXPECT_FALSE(problem.has_value()) << *problem;
+}
+
+TEST_F(VolumeFixture, LeafMetadataRejectsRecordsOfOtherNodesAndStoresNothing) {
+  const OctreeLayout layout(kExtent, {4, 4, 4});
+  ResidencyOctree tree(hierarchy_, layout, 1, nothing_resident_);
+  const ValueRange r{0.0, 1.0};
+  std::vector<LeafScan> leaves =
+      scan_leaves(layout, hierarchy_, r, {0, 0, 0}, level0_brick({0, 0, 0}));
+  ASSERT_FALSE(leaves.empty());
+  const std::vector<std::uint32_t> before(tree.words().begin(), tree.words().end());
+  // Leaves of brick (0, 0, 0) handed in as brick (1, 0, 0)'s; the root; an index past the tree.
+  EXPECT_RESOCT_ERROR(tree.leaf_metadata(0, {1, 0, 0}, leaves), ErrorCode::out_of_range,
+                      "not a leaf of level-0 brick (1, 0, 0)");
+  std::vector<LeafScan> root = leaves;
+  root.back().leaf = 0;
+  EXPECT_RESOCT_ERROR(tree.leaf_metadata(0, {0, 0, 0}, root), ErrorCode::out_of_range, "leaf 0 ");
+  std::vector<LeafScan> past = leaves;
+  past.front().leaf = layout.node_count();
+  EXPECT_RESOCT_ERROR(tree.leaf_metadata(0, {0, 0, 0}, past), ErrorCode::out_of_range,
+                      "not a leaf");
+  EXPECT_RESOCT_ERROR(tree.leaf_metadata(1, {0, 0, 0}, leaves), ErrorCode::out_of_range, "slot");
+  EXPECT_RESOCT_ERROR(tree.leaf_metadata(0, n_bricks_past(), leaves), ErrorCode::out_of_range,
+                      "outside level 0");
+  EXPECT_TRUE(std::equal(before.begin(), before.end(), tree.words().begin(), tree.words().end()));
+  // Scans of a brick outside the level, of a wrong buffer, of a brick that is not constant.
+  EXPECT_RESOCT_ERROR(scan_leaves(layout, hierarchy_, r, n_bricks_past(), level0_brick({0, 0, 0})),
+                      ErrorCode::out_of_range, "outside level 0");
+  EXPECT_RESOCT_ERROR(scan_leaves(layout, hierarchy_, r, {0, 0, 0}, std::vector<std::byte>(7)),
+                      ErrorCode::invalid_argument, "voxels");
+  BrickMeta varied;
+  varied.constant = false;
+  EXPECT_RESOCT_ERROR(scan_constant_leaves(layout, hierarchy_, r, {0, 0, 0}, varied),
+                      ErrorCode::invalid_argument, "meta");
 }
 
 TEST_F(VolumeFixture, MetadataSurvivesEviction) {
