@@ -57,11 +57,17 @@ RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint l
   uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
   uint local = node - D.first_node;
   vec3 ad = abs(dir_vox);
-  float end = node_end;
+  // The sample's position relative to the current node's corner; a step changes one axis's
+  // component, recomputed from the integers (the same float as resoct_relative_origin).
+  vec3 rel = resoct_relative_origin(cell, frac, lo);
+  // The last node found to continue the run (its corner): the run's end is its exit, since the
+  // exits of consecutive nodes along the ray never decrease (each is a minimum of per-axis
+  // products, and a step only moves one axis's far face further along the ray).
+  ivec3 run_lo = lo;
+  bool ran = false;
   for (uint i = 0u; i < RESOCT_NODE_RUN_LENGTH; ++i) {
     // Distance to the far face per axis, in level-0 voxels (infinite where the ray is parallel):
     // the exit along an axis is dist / |dir|, compared across axes as dist_a * |dir_b|.
-    vec3 rel = resoct_relative_origin(cell, frac, lo);
     vec3 dist = vec3(dir_vox.x > 0.0f ? float(ne.x) - rel.x : rel.x,
                      dir_vox.y > 0.0f ? float(ne.y) - rel.y : rel.y,
                      dir_vox.z > 0.0f ? float(ne.z) - rel.z : rel.z);
@@ -90,9 +96,12 @@ RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint l
     if (any(lessThan(lo, box_lo)) || any(greaterThan(lo + ne, box_hi))) break;
     stats.nodes = stats.nodes + 1u;
     if (!resoct_node_class_all(f, bank, n, live, D.first_node + local, cls)) break;
-    end = max(end, resoct_box_exit_t(cell, frac, inv_vox, lo, lo + ne));
+    run_lo = lo;
+    ran = true;
+    rel[axis] = resoct_int_difference(cell[axis], lo[axis]) + frac[axis];
   }
-  return end;
+  if (!ran) return node_end;
+  return max(node_end, resoct_box_exit_t(cell, frac, inv_vox, run_lo, run_lo + ne));
 }
 
 RESOCT_KERNEL_END
