@@ -311,9 +311,16 @@ LoadedBrick BrickLoader::deliver(std::shared_ptr<const HostBrick> brick,
   if (leaf_layout_ && b.key.level() == 0 && !b.meta.constant) {
     // The series' range, as the renderer gives the octree slot (ResidencyOctree::remap_slot).
     const BrickSource& series = *sources_->series();
-    out.leaves = scan_leaves(*leaf_layout_, series.hierarchy(),
-                             series.volume().range(b.key.channel()), b.key.brick(), b.voxels);
-    out.leaf_size = leaf_layout_->leaf_size();
+    try {
+      out.leaves = scan_leaves(*leaf_layout_, series.hierarchy(),
+                               series.volume().range(b.key.channel()), b.key.brick(), b.voxels);
+      out.leaf_size = leaf_layout_->leaf_size();
+    } catch (const std::exception&) {
+      // A worker thread must survive anything (also bad_alloc): the brick goes out without the
+      // records, and the renderer scans it on its own thread (where an error is reported).
+      out.leaves.clear();
+      out.leaf_size = glm::uvec3(0);
+    }
   }
   return out;
 }
