@@ -148,7 +148,26 @@ std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r) {
   if (t == VoxelType::f32) return lut;
   // Integer types: the occupancy bit of every possible value, looked up instead of recomputed.
   lut.resize(t == VoxelType::u8 ? 256u : 65536u);
-  for (std::size_t v = 0; v < lut.size(); ++v) lut[v] = occupancy_bit(double(v), r);
+  const std::size_t n = lut.size();
+  if (!(std::isfinite(r.lo) && std::isfinite(r.hi) && r.lo < r.hi)) {
+    for (std::size_t v = 0; v < n; ++v) lut[v] = occupancy_bit(double(v), r);
+    return lut;
+  }
+  // For lo < hi the bin never decreases with the value (every step of occupancy_bit's arithmetic
+  // rounds monotonically), so the table is at most 32 runs of one bit: each run's end is found by
+  // bisection with occupancy_bit itself, about 500 evaluations instead of 65536 for u16 (a
+  // measurable part of opening a small many-channel file, and of every fuzzed input).
+  std::size_t v = 0;
+  while (v < n) {
+    const std::uint32_t bit = occupancy_bit(double(v), r);
+    std::size_t same = v, other = n;  // bit at `same`; a different bit (or the end) at `other`
+    while (other - same > 1) {
+      const std::size_t mid = same + (other - same) / 2;
+      (occupancy_bit(double(mid), r) == bit ? same : other) = mid;
+    }
+    std::fill(lut.begin() + std::ptrdiff_t(v), lut.begin() + std::ptrdiff_t(other), bit);
+    v = other;
+  }
   return lut;
 }
 
