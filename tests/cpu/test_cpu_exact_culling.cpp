@@ -129,5 +129,50 @@ TEST(ExactCulling, CoarseLevelsCullOnlyWhatTheirSamplesCannotSee) {
   }
 }
 
+// A node whose value range the transfer function shows wholly (every value of its range visible)
+// can have no EMPTY node below it: the residency march stops its descent there and takes the
+// node's whole box as one visible node (kernel resoct_node_full). Nothing is skipped either way,
+// so the image is the page table's to the bit; what changes is the node visits, one per ray
+// (the root) instead of a descent per 4³ leaf. The same data under a transfer function that hides
+// its lower half descends as before.
+TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
+  VolumeDesc v;
+  v.extent = {32, 32, 32};
+  v.type = VoxelType::u8;
+  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
+    const glm::dvec3 q(p);
+    return std::round(150.0 + 90.0 * std::sin(0.3 * q.x) * std::cos(0.25 * q.y) *
+                                  std::sin(0.2 * q.z + 1.0));
+  });
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(4);
+  ResidentScene rs(src, {0}, ro);
+  for (double hidden_below : {0.1, 0.5}) {
+    Scene s = make_scene(40, oblique_camera());
+    s.channels = {make_channel(0,
+                               {{0.0, {1, 1, 1, 0}},
+                                {hidden_below, {1, 1, 1, 0}},
+                                {hidden_below + 0.05, {0.9, 0.6, 0.2, 0.05}},
+                                {1.0, {1, 1, 1, 0.2}}},
+                               0, 0)};
+    const std::string what = "hidden below " + std::to_string(hidden_below);
+    FrameOptions o;
+    o.mode = RenderMode::pagetable;
+    const Rendered pt = render_cpu(rs, s, o);
+    o.mode = RenderMode::residency;
+    const Rendered res = render_cpu(rs, s, o);
+    ASSERT_GT(res.stats.samples, 0u) << what;
+    if (hidden_below < 0.2) {
+      // Values 60..240 (0.24..0.94): all visible, nothing to skip.
+      EXPECT_EQ(max_diff(res.image, pt.image), 0.0) << what;
+      EXPECT_EQ(res.stats.samples, pt.stats.samples) << what;
+      EXPECT_LE(res.stats.nodes_visited, res.stats.rays) << what;
+    } else {
+      EXPECT_LT(max_diff(res.image, pt.image), 2e-4) << what;
+      EXPECT_GT(res.stats.nodes_visited, 2 * res.stats.rays) << what;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace resoct::test

@@ -62,6 +62,27 @@ RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
   return RESOCT_NODE_CLASS_VISIBLE;
 }
 
+/// Whether a channel's own record at `node` proves that the descent could find no EMPTY node
+/// below it: the record's range [min16, max16] lies inside the transfer function's visible hull
+/// and every occupancy bin it spans is visible, so every non-empty sub-range (a descendant's
+/// record) passes resoct_node_range_visible. A march may then treat the whole node as one visible
+/// node. Where records do not nest (an APPROX record may be too narrow) a descendant could still
+/// be EMPTY; its samples are then transparent, so sampling it instead of skipping leaves the image
+/// as it is. False for a homogeneous record (VALID, min = max), whose value the traversal uses
+/// without sampling.
+RESOCT_FN bool resoct_node_full(uint node, ResoctSlotInfo s, uint node_slots) {
+  uint base = resoct_node_base(node, s.slot, node_slots);
+  uint state = resoct_node_state(resoct_read_node(base + RESOCT_NODE_FLAGS));
+  if (state == RESOCT_NODE_INVALID) return false;
+  uint minmax = resoct_read_node(base + RESOCT_NODE_MINMAX);
+  if (resoct_node_range_empty(minmax)) return false;
+  uint lo = resoct_node_min16(minmax);
+  uint hi = resoct_node_max16(minmax);
+  if (lo < s.vis_lo16 || hi > s.vis_hi16) return false;
+  if (state == RESOCT_NODE_VALID && lo == hi) return false;
+  return (resoct_node_range_bins(minmax) & ~s.vis_bins) == 0u;
+}
+
 /// Deepest octree depth whose nodes are at least `dt` long on every axis (smaller nodes cannot
 /// skip more than a step), at least `start_depth`; `vpb` = level-0 voxels per box unit.
 RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, vec3 vpb, float dt) {

@@ -123,6 +123,16 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
   uint cached_empty = 0u;
   uint cached_homog = 0u;
   uint cached_skip_depth = RESOCT_NONE_U;
+  // 1 when the cached node is an ancestor of the traversal node at which the descent stopped
+  // because no node below it can be EMPTY for a live channel (resoct_node_full): then its whole
+  // box is one visible node, with no descent, classification or run inside it.
+  uint cached_full = 0u;
+  // Plain rendering only: effects and pre-integration read values or node words whose results
+  // the descent's depth could change.
+  bool full_stops = true;
+  RESOCT_IF_FX(RESOCT_EFFECT_ANY | RESOCT_EFFECT_PREINT) {
+    full_stops = false;
+  }
   // The last descent's path: per depth d in [start_depth, path_end] the node's local index and
   // the channels found empty down to it; path_skip = 1 when every channel was empty at path_end.
   uint path_local[RESOCT_MAX_DEPTHS];
@@ -290,6 +300,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             cached_depth = cap_depth;
             cached_homog = 0u;
             cached_skip_depth = RESOCT_NONE_U;
+            cached_full = 0u;
+            uint full_depth = RESOCT_NONE_U;
             uint state = 0u;
             uint local = 0u;
             uint d_first = 0u;
@@ -370,9 +382,30 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                 cached_skip_depth = d;
                 break;
               }
+              if (full_stops) {
+                // Channel ci is visible here; when it and every later live channel are full, no
+                // node below can be skipped for them: this node is the traversal node.
+                bool full = true;
+                for (uint c = ci; c < n && full; ++c) {
+                  if (((live >> c) & 1u) != 0u) {
+                    full = resoct_node_full(nd, resoct_read_slot(bank + c), f.node_slot_count);
+                  }
+                }
+                if (full) {
+                  full_depth = d;
+                  break;
+                }
+              }
             }
             cached_empty = state;
-            if (cached_skip_depth == RESOCT_NONE_U) {
+            if (full_depth != RESOCT_NONE_U) {
+              ResoctDepthInfo Df = resoct_read_depth(full_depth);
+              cached_node = Df.first_node + local;
+              uvec3 fne = uvec3(Df.node_extent_x, Df.node_extent_y, Df.node_extent_z);
+              cached_lo = ivec3(resoct_ancestor_coord(Df, trav_coord, trav_log2) * fne);
+              cached_hi = cached_lo + ivec3(fne);
+              cached_full = 1u;
+            } else if (cached_skip_depth == RESOCT_NONE_U) {
               // The remaining channels at the traversal node. A node whose own record is INVALID
               // is requested; its class is carried down from the nearest ancestor with metadata
               // (not empty when there is none).
@@ -563,8 +596,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
         // at the node settles a channel (no empty or homogeneous class, no source chosen by the
         // node), and not for projections, whose classes follow the values along the ray.
         bool merge = f.mode == RESOCT_MODE_RESIDENCY && !skip &&
-                     cached_skip_depth == RESOCT_NONE_U && class_empty == 0u && class_homog == 0u &&
-                     !seg_node_dep;
+                     cached_skip_depth == RESOCT_NONE_U && cached_full == 0u && class_empty == 0u &&
+                     class_homog == 0u && !seg_node_dep;
         RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
           merge = false;
         }
