@@ -4,7 +4,8 @@
 //
 //   BM_OctreeAddEvict/<leaf>/<slots>/<level>  one brick_added + one brick_evicted per item
 //   BM_OctreeAdd/..., BM_OctreeEvict/...      the two halves separately, in batches of distinct
-//                                             bricks (the other half paused)
+//                                             bricks (the other half paused, and its share of
+//                                             the counters taken out)
 //   BM_OctreeMetadataFromBrick/<leaf>/<smooth> exact leaf metadata from one level-0 brick
 //   BM_OctreeLeafMetadata/<leaf>               storing a level-0 brick's leaf records scanned
 //                                             elsewhere (the frame thread's share since the
@@ -132,6 +133,14 @@ void run(benchmark::State& state, Mode mode) {
   std::size_t i = 0;
   std::int64_t items = 0;
   tree.reset_stats();
+  // The counters of the measured updates only: in the Add and Evict rows the tree's statistics
+  // also count the paused half, whose share is taken out per batch.
+  OctreeUpdateStats measured;
+  auto count = [&measured](const OctreeUpdateStats& from, const OctreeUpdateStats& to) {
+    measured.nodes_visited += to.nodes_visited - from.nodes_visited;
+    measured.words_changed += to.words_changed - from.words_changed;
+    measured.residency_queries += to.residency_queries - from.residency_queries;
+  };
   if (mode == Mode::add_evict) {
     for (auto _ : state) {
       const Key& k = keys[i++ % keys.size()];
@@ -140,15 +149,23 @@ void run(benchmark::State& state, Mode mode) {
       if (i % 1024 == 0) benchmark::DoNotOptimize(tree.take_deltas());
     }
     items = state.iterations();
+    count(OctreeUpdateStats{}, tree.stats());
   } else {
     // Whole batches per half so that PauseTiming's own cost is spread over many bricks.
     for (auto _ : state) {
+      const OctreeUpdateStats before_add = tree.stats();
       if (mode == Mode::evict) state.PauseTiming();
       for (const Key& k : keys) add(k);
       if (mode == Mode::evict) state.ResumeTiming();
+      const OctreeUpdateStats before_evict = tree.stats();
       if (mode == Mode::add) state.PauseTiming();
       for (const Key& k : keys) evict(k);
       if (mode == Mode::add) state.ResumeTiming();
+      if (mode == Mode::add) {
+        count(before_add, before_evict);
+      } else {
+        count(before_evict, tree.stats());
+      }
       benchmark::DoNotOptimize(tree.take_deltas());
     }
     items = state.iterations() * std::int64_t(keys.size());
@@ -158,9 +175,9 @@ void run(benchmark::State& state, Mode mode) {
   state.counters["ns_per_brick"] = benchmark::Counter(
       double(items) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   const double it = double(std::max<std::int64_t>(items, 1));
-  state.counters["nodes_visited"] = double(tree.stats().nodes_visited) / it;
-  state.counters["words_changed"] = double(tree.stats().words_changed) / it;
-  state.counters["queries"] = double(tree.stats().residency_queries) / it;
+  state.counters["nodes_visited"] = double(measured.nodes_visited) / it;
+  state.counters["words_changed"] = double(measured.words_changed) / it;
+  state.counters["queries"] = double(measured.residency_queries) / it;
 }
 
 void BM_OctreeAddEvict(benchmark::State& s) {
