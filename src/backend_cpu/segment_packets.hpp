@@ -12,6 +12,12 @@
 // the loop it replaces; tests/cpu/test_cpu_segment_packets.cpp checks that against the
 // single-source loop.
 //
+// On x86-64 the loop is compiled twice: for the baseline (SSE2) and for AVX2 (three-operand
+// forms, blends, 32-bit lane multiplies), chosen once per process from the CPU
+// (__builtin_cpu_supports). The AVX2 copy performs the same IEEE operations in the same order
+// (the target does not include FMA, so nothing is fused), and the test checks both copies against
+// the single-source loop. Sanitizer builds keep the baseline only.
+//
 // Included by kernel_access.hpp after the kernel accessors, before kernel/traverse.glsl.h, whose
 // march calls it through RESOCT_SEGMENT_SAMPLES.
 #include <cstddef>
@@ -23,6 +29,17 @@
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/step.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__)
+#if defined(__has_feature)
+#if !__has_feature(address_sanitizer) && !__has_feature(thread_sanitizer)
+#define RESOCT_PACKETS_AVX2 1
+#endif
+#else
+#define RESOCT_PACKETS_AVX2 1
+#endif
+#endif
 
 namespace resoct::cpu::detail {
 
@@ -129,14 +146,11 @@ inline v4f load4(const glm::vec4& v) {
   return r;
 }
 
-// The march's entry (RESOCT_SEGMENT_SAMPLES), with kernel::resoct_segment_samples' contract.
-// Kept out of the march (noinline) like the loop it replaces.
-[[gnu::noinline]] inline bool segment_samples_packets(const kernel::ResoctFrame& f,
-                                                      const kernel::ResoctSource& src, float dt,
-                                                      float t_exit, float seg_next, float seg,
-                                                      float tm, float t_grid, std::uint32_t& grid_j,
-                                                      float& t, glm::vec4& acc,
-                                                      kernel::ResoctRayStats& stats) {
+// The loop, with kernel::resoct_segment_samples' contract; inlined into each compiled copy.
+[[gnu::always_inline]] inline bool segment_samples_packets_body(
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
+    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
+    glm::vec4& acc, kernel::ResoctRayStats& stats) {
   using namespace kernel;
   const KernelContext& ctx = *t_ctx;
   const bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
@@ -264,6 +278,49 @@ inline v4f load4(const glm::vec4& v) {
   stats.iterations = iterations;
   stats.marched = marched;
   return saturated;
+}
+
+// The compiled copies, kept out of the march (noinline) like the loop they replace.
+[[gnu::noinline]] inline bool segment_samples_packets_baseline(
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
+    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
+    glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  return segment_samples_packets_body(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t, acc,
+                                      stats);
+}
+#ifdef RESOCT_PACKETS_AVX2
+[[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
+    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
+    glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  return segment_samples_packets_body(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t, acc,
+                                      stats);
+}
+#endif
+
+/// Whether this process runs the AVX2 copy of the loop.
+inline bool segment_packets_avx2() {
+#ifdef RESOCT_PACKETS_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2") != 0;
+  return avx2;
+#else
+  return false;
+#endif
+}
+
+// The march's entry (RESOCT_SEGMENT_SAMPLES): the copy this CPU runs fastest.
+inline bool segment_samples_packets(const kernel::ResoctFrame& f, const kernel::ResoctSource& src,
+                                    float dt, float t_exit, float seg_next, float seg, float tm,
+                                    float t_grid, std::uint32_t& grid_j, float& t, glm::vec4& acc,
+                                    kernel::ResoctRayStats& stats) {
+#ifdef RESOCT_PACKETS_AVX2
+  if (segment_packets_avx2()) {
+    return segment_samples_packets_avx2(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t,
+                                        acc, stats);
+  }
+#endif
+  return segment_samples_packets_baseline(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t,
+                                          acc, stats);
 }
 
 }  // namespace resoct::cpu::detail

@@ -2,7 +2,8 @@
 // against the single-source loop it replaces (kernel/segment_samples.glsl.h, which the Vulkan
 // backend runs): for random sources, rays, transfer functions, steps, ends and iteration caps,
 // both must return bit-identical results: saturation, t, the accumulated colour and every
-// statistic. A difference of one ulp anywhere would make images depend on the backend's loop.
+// statistic, for each compiled copy of the packet loop (baseline and, on x86-64 CPUs that have
+// it, AVX2). A difference of one ulp anywhere would make images depend on the backend's loop.
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -28,7 +29,22 @@ using resoct::VoxelType;
 using resoct::cpu::detail::BrickGeometry;
 using resoct::cpu::detail::KernelContext;
 
-constexpr glm::ivec3 kPadded{10, 9, 7};  // not cubic: strides and clamps differ per axis
+constexpr glm::ivec3 kPadded{10, 9, 7};
+
+using PacketLoop = bool (*)(const k::ResoctFrame&, const k::ResoctSource&, float, float, float,
+                            float, float, float, std::uint32_t&, float&, glm::vec4&,
+                            k::ResoctRayStats&);
+
+// The baseline copy always, the AVX2 copy where the CPU has it and the build made it.
+std::vector<PacketLoop> packet_loops() {
+  std::vector<PacketLoop> loops{&resoct::cpu::detail::segment_samples_packets_baseline};
+#ifdef RESOCT_PACKETS_AVX2
+  if (resoct::cpu::detail::segment_packets_avx2()) {
+    loops.push_back(&resoct::cpu::detail::segment_samples_packets_avx2);
+  }
+#endif
+  return loops;
+}  // not cubic: strides and clamps differ per axis
 
 struct Fixture {
   std::vector<std::byte> cache;  // two slots
@@ -142,15 +158,18 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
     start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
     start.stats.marched = u(rng);
 
-    Outcome scalar = start, packets = start;
+    Outcome scalar = start;
     scalar.saturated = k::resoct_segment_samples(f, src, dt, t_exit, seg_next, seg, tm, t_grid,
                                                  scalar.j, scalar.t, scalar.acc, scalar.stats);
-    packets.saturated = resoct::cpu::detail::segment_samples_packets(
-        f, src, dt, t_exit, seg_next, seg, tm, t_grid, packets.j, packets.t, packets.acc,
-        packets.stats);
+    // Every compiled copy of the packet loop this CPU can run (the backend picks one).
+    for (auto* loop : packet_loops()) {
+      Outcome packets = start;
+      packets.saturated = loop(f, src, dt, t_exit, seg_next, seg, tm, t_grid, packets.j, packets.t,
+                               packets.acc, packets.stats);
+      expect_identical(scalar, packets, c);
+    }
     // The grid index follows t: t is step j of the grid (or the end of the ray's progress).
     if (scalar.t == k::resoct_grid_t(t_grid, scalar.j, dt, -1.0f)) ++on_grid;
-    expect_identical(scalar, packets, c);
     if (::testing::Test::HasFatalFailure()) break;
     if (scalar.saturated) ++saturated;
   }
