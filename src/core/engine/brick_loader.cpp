@@ -332,9 +332,15 @@ void BrickLoader::load_one(const Job& job) {
   std::string failure;
   bool transient = false;
   if (!result) result = read_brick(*job.source, r.key, job.timepoint, failure, transient);
-  // The leaves' records are computed here, outside the lock, also for a host cache hit.
+  // The leaves' records are computed here, outside the lock, also for a host cache hit; not for a
+  // job a timepoint switch has already made stale (it is dropped below).
+  bool stale = false;
+  {
+    std::lock_guard lock(mutex_);
+    stale = job.generation != generation_;
+  }
   std::optional<LoadedBrick> loaded;
-  if (result) loaded = deliver(result, r);
+  if (result && !stale) loaded = deliver(result, r);
   {
     std::lock_guard lock(mutex_);
     if (job.generation != generation_) {

@@ -1,11 +1,8 @@
 // Residency octree culling metadata: the per-record rule, upward propagation and the two ways
 // metadata arrives (region queries and, as a fallback, brick voxels).
 #include <algorithm>
-#include <cmath>
-#include <cstring>
-#include <limits>
-#include <type_traits>
 #include <string>
+#include <vector>
 
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
@@ -154,20 +151,19 @@ void ResidencyOctree::leaf_metadata(std::uint32_t slot, glm::uvec3 brick,
                                     std::span<const LeafScan> leaves) {
   check_slot(slot);
   check_brick(0, brick);
-  const std::uint32_t d = layout_.leaf_depth();
-  const NodeCoordRange range = layout_.node_range(d, hierarchy_.level0_box(0, brick));
-  const std::uint64_t first = layout_.depth(d).first_node;
+  // Only the leaves whose records this brick can give (scan_leaves' rule, for_each_exact_leaf):
+  // a leaf that merely overlaps the brick, or whose sampling support the padded brick does not
+  // hold, would get a record of voxels it does not cover.
+  std::vector<std::uint64_t> exact;
+  for_each_exact_leaf(layout_, hierarchy_, brick,
+                      [&exact](std::uint64_t leaf, const Box3&) { exact.push_back(leaf); });
+  std::sort(exact.begin(), exact.end());
   for (const LeafScan& l : leaves) {
-    bool inside = l.leaf >= first && l.leaf < layout_.node_count();
-    if (inside) {
-      const glm::uvec3 c = layout_.node_coord(l.leaf);
-      inside = glm::all(glm::greaterThanEqual(c, range.lo)) && glm::all(glm::lessThan(c, range.hi));
-    }
-    if (!inside) {
+    if (!std::binary_search(exact.begin(), exact.end(), l.leaf)) {
       throw Error(ErrorCode::out_of_range,
                   "leaf " + std::to_string(l.leaf) + " is not a leaf of level-0 brick (" +
                       std::to_string(brick.x) + ", " + std::to_string(brick.y) + ", " +
-                      std::to_string(brick.z) + ")");
+                      std::to_string(brick.z) + ") whose sampling support the brick holds");
     }
   }
   for (const LeafScan& l : leaves) {
@@ -177,6 +173,8 @@ void ResidencyOctree::leaf_metadata(std::uint32_t slot, glm::uvec3 brick,
     o.exact_occupancy = l.occupancy;
     o.has_approx = false;
   }
+  const std::uint32_t d = layout_.leaf_depth();
+  const NodeCoordRange range = layout_.node_range(d, hierarchy_.level0_box(0, brick));
   if (!range.empty()) propagate_metadata(slot, d, range);
 }
 

@@ -484,6 +484,29 @@ TEST_F(VolumeFixture, LeafMetadataRejectsRecordsOfOtherNodesAndStoresNothing) {
   EXPECT_RESOCT_ERROR(tree.leaf_metadata(0, n_bricks_past(), leaves), ErrorCode::out_of_range,
                       "outside level 0");
   EXPECT_TRUE(std::equal(before.begin(), before.end(), tree.words().begin(), tree.words().end()));
+  // Leaves of 6³ straddle the bricks' faces: a leaf that only overlaps brick (0, 0, 0) has no
+  // record from it (scan_leaves gives none), and one handed in is rejected.
+  const OctreeLayout straddling(kExtent, {6, 6, 6});
+  ResidencyOctree tree6(hierarchy_, straddling, 1, nothing_resident_);
+  const std::uint32_t d6 = straddling.leaf_depth();
+  const NodeCoordRange overlap = straddling.node_range(d6, hierarchy_.level0_box(0, glm::uvec3(0)));
+  std::vector<LeafScan> partial;
+  straddling.for_each_node(d6, overlap, [&](std::uint64_t leaf, glm::uvec3) {
+    const Box3 nb = straddling.node_box(d6, straddling.node_coord(leaf));
+    if (intersect(nb, hierarchy_.level0_box(0, glm::uvec3(0))) != nb) {
+      partial.push_back(LeafScan{leaf, leaves.front().minmax, leaves.front().occupancy});
+    }
+  });
+  ASSERT_FALSE(partial.empty());
+  for (const LeafScan& l :
+       scan_leaves(straddling, hierarchy_, r, {0, 0, 0}, level0_brick({0, 0, 0}))) {
+    for (const LeafScan& p : partial) EXPECT_NE(l.leaf, p.leaf);
+  }
+  const std::vector<std::uint32_t> before6(tree6.words().begin(), tree6.words().end());
+  EXPECT_RESOCT_ERROR(tree6.leaf_metadata(0, {0, 0, 0}, partial), ErrorCode::out_of_range,
+                      "whose sampling support the brick holds");
+  EXPECT_TRUE(
+      std::equal(before6.begin(), before6.end(), tree6.words().begin(), tree6.words().end()));
   // Scans of a brick outside the level, of a wrong buffer, of a brick that is not constant.
   EXPECT_RESOCT_ERROR(scan_leaves(layout, hierarchy_, r, n_bricks_past(), level0_brick({0, 0, 0})),
                       ErrorCode::out_of_range, "outside level 0");
