@@ -1,23 +1,27 @@
 // Frames to convergence on a scripted camera path, with and without prefetching (paper 001's
 // predictive paging by linear extrapolation). The camera orbits the volume (path 0, 5 degrees a
-// frame) or flies towards its centre (path 1) for 24 frames and then stops; frames are paced at
-// a fixed period (an interactive display loop that does not wait for loads), and every brick
-// read costs a fixed latency (a slow disk or a remote server). Counters:
+// frame) or flies towards its centre (path 1) for 24 frames and then stops.
+//
+// Time is simulated, so every run gives the same counters: loading is synchronous
+// (loader_threads = 0) and a frame reads at most K bricks (upload_budget.max_bricks), the
+// requested ones first and prefetches only when no request is left (docs/renderer.md, step 8),
+// which is a loader that reads K bricks per display period and takes a prefetch only while idle.
+// K = 31 stands for a 250 ms period at 8 ms per brick read (a slow disk or a remote server);
+// RESOCT_PREFETCH_BRICKS_PER_FRAME overrides it. Counters:
 //   unconverged_on_path  frames along the path whose image still lacked bricks
 //   frames_after_stop    frames after the camera stopped until the image converged
 //   missing_requests     device brick requests summed over the path (how much was missing)
 //   prefetched, prefetch_hits  bricks read ahead, and requests those reads served
+//   bricks_read          bricks read in all (requests and prefetches), whole run
 // Args: lookahead frames (0 = prefetching off), path. One iteration per run (a cold renderer).
-// RESOCT_BENCH_SMOKE=1: a short path, no latency.
+// RESOCT_BENCH_SMOKE=1: a short path on a small volume.
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <string>
-#include <thread>
 
 #include "resoct/cpu/cpu_backend.hpp"
 #include "resoct/sources/procedural_source.hpp"
@@ -29,27 +33,6 @@
 using namespace resoct;
 
 namespace {
-
-/// Adds a fixed latency to every brick read.
-class SlowSource final : public BrickSource {
- public:
-  SlowSource(std::unique_ptr<BrickSource> inner, std::chrono::microseconds latency)
-      : inner_(std::move(inner)), latency_(latency) {}
-  const BrickHierarchy& hierarchy() const override { return inner_->hierarchy(); }
-  void read_brick(BrickKey key, std::span<std::byte> out) const override {
-    std::this_thread::sleep_for(latency_);
-    inner_->read_brick(key, out);
-  }
-  BrickMeta brick_meta(BrickKey key) const override { return inner_->brick_meta(key); }
-  RegionMeta region_meta(std::uint32_t c, const Box3& b) const override {
-    return inner_->region_meta(c, b);
-  }
-  std::string name() const override { return "slow:" + inner_->name(); }
-
- private:
-  std::unique_ptr<BrickSource> inner_;
-  std::chrono::microseconds latency_;
-};
 
 /// Pose of frame f (held at the last pose after the path): kind 0 orbits the volume centre by
 /// 5 degrees a frame; kind 1 flies towards the centre, from 1.0 to 0.45 of the start distance,
@@ -67,49 +50,34 @@ void BM_PrefetchPath(benchmark::State& state) {
   const auto lookahead = std::uint32_t(state.range(0));
   const int kind = int(state.range(1));
   const bool tiny = bench::loading_smoke();
-  // The period exceeds the render time of a 32x32 frame even on a loaded machine, so that loading,
-  // not rendering, limits progress: one loader thread at 8 ms per brick
-  // (RESOCT_PREFETCH_LATENCY_US) reads about 30 bricks a frame, a little more than the orbit needs
-  // anew per frame, so prefetching has idle reads to use.
   const std::uint32_t path = tiny ? 4 : 24;
-  const char* env_period = std::getenv("RESOCT_PREFETCH_PERIOD_MS");
-  const auto period = std::chrono::milliseconds(tiny         ? 1
-                                                : env_period ? std::atol(env_period)
-                                                             : 250);
-  const char* env_latency = std::getenv("RESOCT_PREFETCH_LATENCY_US");
-  const auto latency = std::chrono::microseconds(tiny          ? 0
-                                                 : env_latency ? std::atol(env_latency)
-                                                               : 8000);
+  const char* env_k = std::getenv("RESOCT_PREFETCH_BRICKS_PER_FRAME");
+  const std::uint64_t per_frame = tiny ? 8 : env_k ? std::strtoull(env_k, nullptr, 10) : 31;
   cpu::register_backend();
   Scene scene = parse_scene(bench::kTurbulenceScene, "turbulence");
   scene.viewport = Viewport{tiny ? 24u : 32u, tiny ? 24u : 32u};
   scene.camera.eye = scene.camera.target + 0.75 * (scene.camera.eye - scene.camera.target);
 
   double unconverged = 0, after_stop = 0, missing = 0, prefetched = 0, hits = 0, converged = 0;
-  double render_ms = 0, frames = 0;
+  double read = 0;
   for (auto _ : state) {
-    auto src = std::make_shared<SlowSource>(
-        make_procedural_source(
-            tiny ? "procedural:turbulence:48x48x48" : "procedural:turbulence:192x192x192",
-            BrickLayout{glm::uvec3(16), 1}),
-        latency);
+    std::shared_ptr<const BrickSource> src = make_procedural_source(
+        tiny ? "procedural:turbulence:48x48x48" : "procedural:turbulence:192x192x192",
+        BrickLayout{glm::uvec3(16), 1});
     RendererOptions o;
     o.backend = "cpu";
     o.backend_options.threads = 1;
-    o.loader_threads = 1;
+    o.loader_threads = 0;
+    o.upload_budget.max_bricks = std::max<std::uint64_t>(per_frame, 1);
     o.leaf_size = glm::uvec3(16);
     o.prefetch.lookahead_frames = lookahead;
     o.prefetch.max_bricks = 48;
     Renderer r(src, o);
-    std::uint32_t f = 0;
     bool done = false;
-    for (; f < path + 200 && !done; ++f) {
-      const auto t0 = std::chrono::steady_clock::now();
+    for (std::uint32_t f = 0; f < path + 200 && !done; ++f) {
       Scene s = scene;
       s.camera = pose(scene.camera, kind, f, path);
       const FrameReport rep = r.render_frame(s);
-      render_ms += rep.stats.ms_frame;
-      frames += 1;
       if (f < path) {
         unconverged += rep.converged ? 0 : 1;
         missing += double(rep.stats.brick_requests);
@@ -118,11 +86,12 @@ void BM_PrefetchPath(benchmark::State& state) {
       } else {
         after_stop += 1;
       }
-      std::this_thread::sleep_until(t0 + period);
     }
     converged += done ? 1 : 0;
-    prefetched += double(inspect::loader(r).stats().prefetched);
-    hits += double(inspect::loader(r).stats().prefetch_hits);
+    const BrickLoaderStats ls = inspect::loader(r).stats();
+    prefetched += double(ls.prefetched);
+    hits += double(ls.prefetch_hits);
+    read += double(ls.loads + ls.prefetched);
   }
   const double n = double(state.iterations());
   state.counters["unconverged_on_path"] = unconverged / n;
@@ -132,8 +101,8 @@ void BM_PrefetchPath(benchmark::State& state) {
   state.counters["prefetch_hits"] = hits / n;
   state.counters["path_frames"] = path;
   state.counters["converged"] = converged / n;
-  // Above the period, rendering rather than loading limited the run (a loaded machine).
-  state.counters["ms_per_frame"] = render_ms / std::max(1.0, frames);
+  state.counters["bricks_read"] = read / n;
+  state.counters["bricks_per_frame"] = double(per_frame);
   state.SetLabel(std::string(kind == 0 ? "orbit" : "dolly") +
                  (lookahead == 0 ? ", no prefetch" : ", prefetch"));
 }

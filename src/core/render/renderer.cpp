@@ -320,10 +320,11 @@ bool Renderer::Impl::handle_requests(const FrameResult& result, std::uint64_t ep
   if (!resolved.block_misses.empty()) outstanding = true;
   waiting_since_ = std::move(still_waiting);
   loader_->request(wanted);
+  sync_loaded_ = 0;
   if (loader_->thread_count() == 0) {
     const std::uint64_t n =
         std::min<std::uint64_t>(wanted.size(), options_.upload_budget.max_bricks);
-    loader_->run_queued(std::size_t(n));
+    sync_loaded_ = loader_->run_queued(std::size_t(n));
   }
   stats.loads_queued = loader_->queued();
   stats.loads_in_flight = loader_->in_flight();
@@ -386,7 +387,13 @@ void Renderer::Impl::prefetch(const Scene& scene, FrameStats& stats) {
   stats.prefetch_next_timepoint = timed.size() - keys.size();
   // Replaces the previous frame's prefetches: the prediction moved on.
   loader_->prefetch(std::span<const TimedBrickKey>(timed));
-  if (loader_->thread_count() == 0) loader_->run_prefetch(timed.size());
+  if (loader_->thread_count() == 0 && loader_->queued() == 0) {
+    // Synchronous loading stands for a loader that reads the brick budget per frame: prefetches
+    // take what the requests left of it, and only when no request waits (a worker thread takes a
+    // prefetch only then too), so a frame never reads more than the budget.
+    const std::size_t left = std::size_t(options_.upload_budget.max_bricks) - sync_loaded_;
+    loader_->run_prefetch(std::min(timed.size(), left));
+  }
   stats.prefetch_queued = timed.size();
 }
 

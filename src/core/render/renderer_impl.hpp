@@ -85,6 +85,8 @@ struct Renderer::Impl {
   std::shared_ptr<detail::SharedEye> host_camera_ = std::make_shared<detail::SharedEye>();
   CameraPredictor predictor_;
   std::uint64_t frame_ = 0;
+  // loader_threads = 0: bricks the frame's requests loaded synchronously (of the brick budget).
+  std::size_t sync_loaded_ = 0;
   bool send_full_ = true;                      // next update carries full arrays
   std::vector<LoadedBrick> staged_;            // loaded, waiting for budget or a free slot
   std::vector<std::uint32_t> pending_nodes_;   // node requests to answer next frame
