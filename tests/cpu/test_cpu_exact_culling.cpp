@@ -104,8 +104,8 @@ TEST(ExactCulling, BandsBetweenOccupiedValuesAreNotCulled) {
 
 // Channels that sample coarse levels only: culled nodes must not take away the visible
 // neighbours of samples near their faces (a level-l sample reads voxels up to half a level voxel
-// beyond the node). Residency and page table agree within 1/255 at every pixel for levels
-// [2, 2] and [3, 3], with 4³ leaves (fine nodes, so many faces).
+// beyond the node). Residency, standard octree and page table agree within 1/255 at every pixel
+// for levels [2, 2] and [3, 3], with 4³ leaves (fine nodes, so many faces).
 TEST(ExactCulling, CoarseLevelsCullOnlyWhatTheirSamplesCannotSee) {
   ProceduralSource src("procedural:tubes:128x128x128", bricks8());
   ResidentOptions ro;
@@ -126,7 +126,38 @@ TEST(ExactCulling, CoarseLevelsCullOnlyWhatTheirSamplesCannotSee) {
     const Rendered pt = render_cpu(rs, s, o);
     EXPECT_LT(max_diff(res.image, pt.image), 1.0 / 255.0) << "level " << level;
     EXPECT_GT(res.stats.distance_skipped, 0.0) << "level " << level << ": nothing culled";
+    // The standard-octree mode culls whole bricks of the walk by the same node records (the
+    // node that is the brick, shrunk by the walked level's margin).
+    o.mode = RenderMode::octree;
+    const Rendered oct = render_cpu(rs, s, o);
+    EXPECT_LT(max_diff(oct.image, pt.image), 1.0 / 255.0) << "octree, level " << level;
   }
+}
+
+// The standard-octree mode (paper 000 §8's baseline) culls with the residency mode's data: a
+// brick of its walk whose node record the transfer function cannot see ends the walk with the
+// channel empty, so on sparse blobs over a hidden noise floor it takes far fewer samples than the
+// page table (which skips only all-zero bricks) and renders the same image.
+TEST(ExactCulling, StandardOctreeCullsBricksByTheirNodeRecords) {
+  ProceduralSource src("procedural:noisefloor:64x64x64", bricks8());
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(4);
+  ResidentScene rs(src, {0}, ro);
+  Scene s = make_scene(40, oblique_camera());
+  s.channels = {make_channel(
+      0, {{0.0, {1, 1, 1, 0}}, {0.2, {1, 1, 1, 0}}, {0.4, {1, 0.6, 0.2, 0.1}}, {1.0, {1, 1, 1, 0.4}}},
+      0, 0)};
+  FrameOptions o;
+  o.mode = RenderMode::pagetable;
+  const Rendered pt = render_cpu(rs, s, o);
+  o.mode = RenderMode::octree;
+  const Rendered oct = render_cpu(rs, s, o);
+  ASSERT_GT(pt.stats.samples, 0u);
+  EXPECT_LT(double(oct.stats.samples), 0.7 * double(pt.stats.samples));
+  EXPECT_GT(oct.stats.distance_skipped, pt.stats.distance_skipped);
+  // Skips advance t by k·dt in one addition, as in the residency mode.
+  EXPECT_LT(max_diff(oct.image, pt.image), 2e-4);
+  EXPECT_TRUE(oct.nodes.empty()) << "every record is supplied: nothing to request";
 }
 
 // A node whose value range the transfer function shows wholly (every value of its range visible)

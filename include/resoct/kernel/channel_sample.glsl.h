@@ -8,6 +8,7 @@
 
 #include "resoct/kernel/common.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
+#include "resoct/kernel/node_class.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
@@ -337,13 +338,21 @@ RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotI
 }
 
 /// Standard-octree mode, one channel: walk the levels from the slot's coarsest to the target at
-/// the position (one node per level); the first missing level is requested and ends the walk,
-/// the finest present level above it is sampled; an EMPTY level that does not show ends it with
-/// the channel empty there. [lo, hi) is clipped to the target brick, which every brick of the
-/// walk contains.
+/// the position (one node per level: paper 000 §8's octree, whose nodes are the bricks); the
+/// first missing level is requested and ends the walk, the finest present level above it is
+/// sampled. A level ends the walk with the channel empty there when its brick is an EMPTY page
+/// that does not show, or, with the residency mode's culling data, when the octree node that is
+/// this brick (ResoctLevelInfo.node_depth) has a record the transfer function cannot see
+/// (resoct_node_class) and the position lies in the brick shrunk by that level's margin
+/// (resoct_culling_margin: a sample there of this level, the coarsest the walk can sample in the
+/// brick, or of a finer one reads only voxels inside the node's record). Such a node without a
+/// record is requested (once per run of requests for it along the ray: `last_node`) and does not
+/// cull. Every mapped brick of the walk is marked used: the walk needs the whole path resident.
+/// [lo, hi) is clipped to the target brick, which every brick of the walk contains.
 RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                            ivec3 cell, vec3 frac, vec3 inv_vox,
-                                            RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
+                                            uint start_depth, ivec3 cell, vec3 frac, vec3 inv_vox,
+                                            RESOCT_INOUT(uint) last_key,
+                                            RESOCT_INOUT(uint) last_node, RESOCT_INOUT(ivec3) lo,
                                             RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
                                             RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
@@ -365,10 +374,33 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
       resoct_request_missing(f, s, l, cell, last_key, st);
       break;
     }
+    ivec3 blo = resoct_brick_lo0(L, bs, b);
+    vec3 bsize = resoct_brick_size0(L, bs);
     if (state == RESOCT_PAGE_STATE_EMPTY && !resoct_empty_page_shows(s, e)) {
-      skip_exit = resoct_box_exit(cell, frac, inv_vox, resoct_brick_lo0(L, bs, b),
-                                  resoct_brick_size0(L, bs));
+      skip_exit = resoct_box_exit(cell, frac, inv_vox, blo, bsize);
       return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
+    }
+    if (state == RESOCT_PAGE_STATE_MAPPED) resoct_mark_used(resoct_page_cache_slot(e));
+    if (L.node_depth != RESOCT_NONE_U) {
+      ResoctDepthInfo D = resoct_read_depth(L.node_depth);
+      uint node =
+          resoct_node_index(L.node_depth, resoct_node_coord(D, cell), resoct_depth_count_log2(D));
+      uint cls = resoct_node_class(node, s, f.node_slot_count);
+      if (cls == RESOCT_NODE_CLASS_INVALID) {
+        if (L.node_depth >= start_depth && node != last_node) {
+          last_node = node;
+          resoct_report_node_request(node);
+          st.requests = st.requests + 1u;
+        }
+      } else if (cls == RESOCT_NODE_CLASS_EMPTY) {
+        ivec3 margin = resoct_culling_margin(resoct_level_factor(L));
+        ivec3 ilo = blo + margin;
+        ivec3 ihi = blo + ivec3(bsize) - margin;
+        if (resoct_in_box(cell, ilo, ihi)) {
+          skip_exit = resoct_box_exit(cell, frac, inv_vox, ilo, vec3(ihi - ilo));
+          return resoct_source_of(RESOCT_CH_EMPTY, 0.0f);
+        }
+      }
     }
     best_entry = e;
     best_level = l;

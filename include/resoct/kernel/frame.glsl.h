@@ -191,6 +191,9 @@ struct ResoctLevelInfo {
   uint extent_y;
   uint extent_z;
   float size_log2;  // log2 of the largest voxel dimension in box units (LOD choice)
+  // The residency-octree depth whose nodes are this level's bricks (the same level-0 boxes), the
+  // standard-octree mode's culling node; RESOCT_NONE_U (0xFFFFFFFF) when no depth matches.
+  uint node_depth;
 };
 
 // One octree depth (see OctreeLayout): node (cx, cy, cz) covers voxels

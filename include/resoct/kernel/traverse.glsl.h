@@ -560,8 +560,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               float exit_c = 0.0f;
               if (f.mode == RESOCT_MODE_OCTREE) {
-                src[c] = resoct_octree_source(sp, s, target, cell, frac, inv_vox, last_key[c],
-                                              src_lo, src_hi, exit_c, stats);
+                src[c] = resoct_octree_source(sp, s, target, f.start_depth, cell, frac, inv_vox,
+                                              last_key[c], last_node_request, src_lo, src_hi,
+                                              exit_c, stats);
               } else {
                 src[c] = resoct_pagetable_source(sp, s, target, cell, frac, inv_vox, last_key[c],
                                                  src_lo, src_hi, exit_c, stats);

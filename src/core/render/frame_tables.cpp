@@ -388,6 +388,14 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     L.extent_y = std::uint32_t(li.extent.y);
     L.extent_z = std::uint32_t(li.extent.z);
     L.size_log2 = sizes[l];
+    // The standard-octree mode's culling node: the depth whose nodes span exactly this level's
+    // bricks, if the layout has one (node and brick grids both start at the volume's corner).
+    L.node_depth = 0xFFFFFFFFu;  // RESOCT_NONE_U
+    const glm::u64vec3 brick0 = glm::u64vec3(hierarchy.layout().brick_size)
+                                << glm::u64vec3(li.factor_log2);
+    for (std::uint32_t d = 0; d < layout.depth_count(); ++d) {
+      if (layout.depth(d).node_extent == brick0) L.node_depth = d;
+    }
     out.levels.push_back(L);
   }
 
