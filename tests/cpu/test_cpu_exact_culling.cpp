@@ -145,7 +145,8 @@ TEST(ExactCulling, StandardOctreeCullsBricksByTheirNodeRecords) {
   ResidentScene rs(src, {0}, ro);
   Scene s = make_scene(40, oblique_camera());
   s.channels = {make_channel(
-      0, {{0.0, {1, 1, 1, 0}}, {0.2, {1, 1, 1, 0}}, {0.4, {1, 0.6, 0.2, 0.1}}, {1.0, {1, 1, 1, 0.4}}},
+      0,
+      {{0.0, {1, 1, 1, 0}}, {0.2, {1, 1, 1, 0}}, {0.4, {1, 0.6, 0.2, 0.1}}, {1.0, {1, 1, 1, 0.4}}},
       0, 0)};
   FrameOptions o;
   o.mode = RenderMode::pagetable;
