@@ -1,6 +1,7 @@
 #include "support/dense_march.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -14,6 +15,7 @@
 
 #include "resoct/volume/brick_key.hpp"
 #include "resoct/scene/camera.hpp"
+#include "resoct/scene/step_lut.hpp"
 #include "resoct/base/error.hpp"
 
 namespace resoct::bench {
@@ -83,6 +85,8 @@ inline float load(const std::byte* base, std::size_t i) {
 struct Setup {
   const DenseMarch::Frame* f;
   const glm::vec4* lut;
+  const glm::vec4* level_luts;  // corrected, premultiplied LUT per step level
+  StepLevels levels;
   std::size_t row, plane;  // strides of the padded array (elements)
 };
 
@@ -133,9 +137,21 @@ template <class T>
   if (ad.z >= kParallelEps) dt = std::min(dt, f.finest_voxel.z / ad.z);
   if (dt >= kTInf) dt = std::min(f.finest_voxel.x, std::min(f.finest_voxel.y, f.finest_voxel.z));
   dt = std::max(dt * f.step_scale, f.min_step);
+  // The step rounded down to its level, whose LUT holds the corrected, premultiplied colours of
+  // full steps (kernel/step_lut.glsl.h); a ray without a level corrects every sample.
+  const glm::vec4* level_lut = nullptr;
+  {
+    const float ratio = dt * (1.0f / f.ref_step);
+    const std::uint32_t level =
+        (std::bit_cast<std::uint32_t>(ratio) >> s.levels.shift) - s.levels.first;
+    if (ratio > 0.0f && level < s.levels.count) {
+      dt = step_level_ratio(s.levels, level) * f.ref_step;
+      level_lut = s.level_luts + std::size_t(level) * kLutSize;
+    }
+  }
   const float end_eps = kSegmentEps * dt;
   const float half_dt = 0.5f * dt;
-  const float ratio_full = dt / f.ref_step;
+  const float ratio_full = dt * (1.0f / f.ref_step);
   // Padded-array coordinate (voxel centres at integers) of the sample at parameter tm:
   // o_cell + 1 + (o_frac + tm · dv) − 0.5 = base + tm · dv. No clamp: samples lie in [t_enter,
   // t_exit), so coordinates stay within rounding of [0.5, extent + 0.5], and the border voxels
@@ -150,8 +166,10 @@ template <class T>
   const std::size_t row = s.row, plane = s.plane;
 
   std::uint64_t n = 0, nv = 0;
-  // One sample at parameter tm of a segment of `ratio` reference steps; true once saturated.
-  const auto sample = [&](float tm, float ratio) [[gnu::always_inline]] {
+  // One sample at parameter tm of a segment of `ratio` reference steps (with `corrected`, a
+  // full step of the ray's level: its LUT); true once saturated.
+  const auto sample = [&](float tm, float ratio,
+                          const glm::vec4* corrected) [[gnu::always_inline]] {
     const float cx = base_x + tm * dv.x;
     const float cy = base_y + tm * dv.y;
     const float cz = base_z + tm * dv.z;
@@ -180,6 +198,13 @@ template <class T>
     const float x = std::min(std::max(value, 0.0f), 1.0f) * float(kLutSize - 1u);
     const std::uint32_t e = std::min(std::uint32_t(x), kLutSize - 2u);
     const float w = x - float(e);
+    if (corrected != nullptr) {
+      const glm::vec4 p = corrected[e] * (1.0f - w) + corrected[e + 1u] * w;
+      if (!(p.a > 0.0f)) return false;
+      ++nv;
+      acc = acc + (1.0f - acc.a) * p;
+      return acc.a >= ert;
+    }
     const glm::vec4 a = lut[e], b = lut[e + 1u];
     const float alpha = a.a * (1.0f - w) + b.a * w;
     if (!(alpha > 0.0f)) return false;
@@ -210,7 +235,7 @@ template <class T>
   bool saturated = false;
   while (t_exit - t >= dt) {
     ++n;
-    if (sample(t + half_dt, ratio_full)) {
+    if (sample(t + half_dt, ratio_full, level_lut)) {
       saturated = true;
       break;
     }
@@ -219,7 +244,7 @@ template <class T>
   while (!saturated && t_exit - t > end_eps) {
     ++n;
     const float seg = std::max(std::min(dt, t_exit - t), 0.0f);
-    if (sample(t + 0.5f * seg, seg / f.ref_step)) break;
+    if (sample(t + 0.5f * seg, seg * (1.0f / f.ref_step), seg == dt ? level_lut : nullptr)) break;
     t = next_t(t);
   }
   samples += n;
@@ -390,6 +415,12 @@ DenseMarch::DenseMarch(const DenseVolume& volume, const Scene& scene) : volume_(
   f.inv_range_width = float(1.0 / (r.hi - r.lo));
   f.extent = glm::ivec3(glm::uvec3(vd.extent));
   lut_ = c.tf.lut(kLutSize);
+  levels_ = step_levels(glm::dvec3(f.finest_voxel), double(f.step_scale), f.min_step, f.ref_step);
+  level_luts_.resize(std::size_t(levels_.count) * kLutSize);
+  for (std::uint32_t l = 0; l < levels_.count; ++l) {
+    step_lut(lut_, step_level_ratio(levels_, l),
+             std::span<glm::vec4>(level_luts_.data() + std::size_t(l) * kLutSize, kLutSize));
+  }
 }
 
 DenseStats DenseMarch::render(Image& image, int threads) const {
@@ -399,6 +430,8 @@ DenseStats DenseMarch::render(Image& image, int threads) const {
   Setup s{};
   s.f = &f;
   s.lut = lut_.data();
+  s.level_luts = level_luts_.data();
+  s.levels = levels_;
   s.row = volume_.padded.x;
   s.plane = std::size_t(volume_.padded.x) * volume_.padded.y;
   glm::vec4* px = image.pixels().data();

@@ -3,9 +3,11 @@
 //
 // One channel's level-0 voxels in one flat array, and the same per-ray definition as the kernel
 // (docs/rendering.md): the same camera rays (float, through pixel centres), the same step
-// (Eq. 8.2-8.3 at level-0 voxels), segments [t, t + Δ) with Δ = min(dt, t_exit − t) sampled at
-// their midpoints, trilinear interpolation with clamp-to-edge, the 1024-entry TF LUT with linear
-// interpolation between entries, opacity correction 1 − (1 − α)^(Δ/Δ₀), front-to-back
+// (Eq. 8.2-8.3 at level-0 voxels, rounded down to its step level), segments [t, t + Δ) with
+// Δ = min(dt, t_exit − t) sampled at their midpoints, trilinear interpolation with clamp-to-edge,
+// the 1024-entry TF LUT with linear interpolation between entries, full steps from the level's
+// opacity-corrected, premultiplied LUT and the last, shorter one corrected per sample
+// (1 − (1 − α)^(Δ/Δ₀), kernel/step_lut.glsl.h), front-to-back
 // compositing and early termination at the scene's ert_opacity; 16×16 tiles over OpenMP with
 // dynamic scheduling like the CPU backend. No bricks, no octree, no page table, no empty-space
 // skipping, no level of detail: every segment of every ray inside the volume is sampled at level 0
@@ -32,6 +34,7 @@
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/backend/image.hpp"
 #include "resoct/scene/scene.hpp"
+#include "resoct/scene/step_lut.hpp"
 
 namespace resoct::bench {
 
@@ -96,6 +99,8 @@ class DenseMarch {
   const DenseVolume& volume_;
   Frame frame_;
   std::vector<glm::vec4> lut_;
+  StepLevels levels_;                  // the frame's step levels (kernel/step_lut.glsl.h)
+  std::vector<glm::vec4> level_luts_;  // their corrected, premultiplied LUTs, level by level
 };
 
 }  // namespace resoct::bench

@@ -162,6 +162,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.depths = tables.depths.data();
   c.tf = tables.tf_luts.data();
   c.preint = tables.preint_tables.data();
+  c.step_luts = tables.step_luts.data();
   c.fx = &tables.fx;
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;

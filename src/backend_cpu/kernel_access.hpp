@@ -50,7 +50,8 @@ struct KernelContext {
   const kernel::ResoctLevelInfo* levels = nullptr;
   const kernel::ResoctDepthInfo* depths = nullptr;
   const glm::vec4* tf = nullptr;
-  const glm::vec4* preint = nullptr;  // pre-integration tables (empty frame: unused)
+  const glm::vec4* preint = nullptr;     // pre-integration tables (empty frame: unused)
+  const glm::vec4* step_luts = nullptr;  // corrected, premultiplied LUTs per step level
   const kernel::ResoctFxFrame* fx = nullptr;
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
@@ -142,6 +143,9 @@ inline vec4 resoct_read_tf(uint slot, uint index) {
 }
 inline vec4 resoct_read_preint(uint slot, uint index) {
   return cpu::detail::t_ctx->preint[std::size_t(slot) * 2048u + index];
+}
+inline vec4 resoct_read_step_lut(uint index) {
+  return cpu::detail::t_ctx->step_luts[index];
 }
 inline ResoctFxFrame resoct_read_fx_frame() {
   return *cpu::detail::t_ctx->fx;

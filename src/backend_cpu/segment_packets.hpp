@@ -28,6 +28,7 @@
 #include "resoct/kernel/composite.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/step.glsl.h"
+#include "resoct/kernel/step_lut.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__SANITIZE_ADDRESS__) && \
@@ -148,15 +149,21 @@ inline v4f load4(const glm::vec4& v) {
 
 // The loop, with kernel::resoct_segment_samples' contract; inlined into each compiled copy.
 [[gnu::always_inline]] inline bool segment_samples_packets_body(
-    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
-    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
-    glm::vec4& acc, kernel::ResoctRayStats& stats) {
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
+    std::uint32_t step_level, float t_exit, float seg_next, float seg, float tm, float t_grid,
+    std::uint32_t& grid_j, float& t, glm::vec4& acc, kernel::ResoctRayStats& stats) {
   using namespace kernel;
   const KernelContext& ctx = *t_ctx;
   const bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
   const std::byte* brick =
       mapped ? ctx.cache + std::size_t(src.cache_slot) * ctx.brick_bytes : nullptr;
   const glm::vec4* tf = ctx.tf + std::size_t(src.tf_slot) * RESOCT_TF_LUT_SIZE;
+  // The step level's corrected, premultiplied LUT (kernel/step_lut.glsl.h), for full steps.
+  const bool have_level = step_level != RESOCT_STEP_LEVEL_NONE;
+  const glm::vec4* level_lut =
+      have_level ? ctx.step_luts + (std::size_t(src.tf_slot) * f.step_level_count + step_level) *
+                                       RESOCT_TF_LUT_SIZE
+                 : nullptr;
   const float eps_dt = RESOCT_SEGMENT_EPS * dt;
 
   v4f a = load4(acc);
@@ -228,31 +235,50 @@ inline v4f load4(const glm::vec4& v) {
     const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
     i0 = select(splat(last) < i0, splat(last), i0);
     const v4f fr = x - __builtin_convertvector(i0, v4f);
-    v4f rgba[4];
-    v4f alpha;
-    for (int l = 0; l < 4; ++l) {
-      // glm::mix(a, b, f) = a * (1 - f) + b * f, per component.
-      const std::size_t i = nan[l] != 0 ? 0u : std::size_t(i0[l]);
-      rgba[l] = load4(tf[i]) * splat(1.0f - fr[l]) + load4(tf[i + 1u]) * splat(fr[l]);
-      if (nan[l] != 0) rgba[l] = splat(0.0f);
-      alpha[l] = rgba[l][3];
+    // Each lane's premultiplied sample (resoct_mix_result of this one channel): full steps of a
+    // ray with a step level from the level's LUT (resoct_step_lut_lookup, 0 where alpha is 0),
+    // the others (the last, shorter step) corrected per sample.
+    v4f pm[4];
+    bool per_sample = !have_level;
+    for (int l = 0; l < m; ++l) per_sample = per_sample || lane_seg[l] != dt;
+    if (per_sample) {
+      v4f rgba[4];
+      v4f alpha;
+      for (int l = 0; l < 4; ++l) {
+        // glm::mix(a, b, f) = a * (1 - f) + b * f, per component.
+        const std::size_t i = nan[l] != 0 ? 0u : std::size_t(i0[l]);
+        rgba[l] = load4(tf[i]) * splat(1.0f - fr[l]) + load4(tf[i + 1u]) * splat(fr[l]);
+        if (nan[l] != 0) rgba[l] = splat(0.0f);
+        alpha[l] = rgba[l][3];
+      }
+      // kernel::resoct_step_ratio per lane.
+      const v4f ratio =
+          v4f{lane_seg[0], lane_seg[1], lane_seg[2], lane_seg[3]} * splat(1.0f / f.ref_step);
+      const v4f corrected = correct_opacity4(alpha, ratio);
+      for (int l = 0; l < 4; ++l) {
+        const float al = corrected[l];
+        pm[l] = splat(0.0f);
+        if (al > 0.0f) {
+          pm[l] = rgba[l] * splat(al);
+          pm[l][3] = al;
+        }
+      }
     }
-    // kernel::resoct_step_ratio per lane.
-    const v4f ratio =
-        v4f{lane_seg[0], lane_seg[1], lane_seg[2], lane_seg[3]} * splat(1.0f / f.ref_step);
-    const v4f corrected = correct_opacity4(alpha, ratio);
+    if (have_level) {
+      for (int l = 0; l < m; ++l) {
+        if (lane_seg[l] != dt) continue;
+        const std::size_t i = nan[l] != 0 ? 0u : std::size_t(i0[l]);
+        v4f p = load4(level_lut[i]) * splat(1.0f - fr[l]) + load4(level_lut[i + 1u]) * splat(fr[l]);
+        if (nan[l] != 0 || !(p[3] > 0.0f)) p = splat(0.0f);
+        pm[l] = p;
+      }
+    }
 
     // Composite in order, as the scalar loop does.
     for (int l = 0; l < m; ++l) {
       if (mapped) ++accesses;
       ++samples;
-      const float al = corrected[l];
-      v4f pm = splat(0.0f);
-      if (al > 0.0f) {
-        pm = rgba[l] * splat(al);
-        pm[3] = al;
-      }
-      a = a + splat(1.0f - a[3]) * pm;
+      a = a + splat(1.0f - a[3]) * pm[l];
       if (a[3] >= f.ert_opacity) {
         saturated = true;
         t_now = lane_t[l];
@@ -282,19 +308,19 @@ inline v4f load4(const glm::vec4& v) {
 
 // The compiled copies, kept out of the march (noinline) like the loop they replace.
 [[gnu::noinline]] inline bool segment_samples_packets_baseline(
-    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
-    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
-    glm::vec4& acc, kernel::ResoctRayStats& stats) {
-  return segment_samples_packets_body(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t, acc,
-                                      stats);
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
+    std::uint32_t step_level, float t_exit, float seg_next, float seg, float tm, float t_grid,
+    std::uint32_t& grid_j, float& t, glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  return segment_samples_packets_body(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                      grid_j, t, acc, stats);
 }
 #ifdef RESOCT_PACKETS_AVX2
 [[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
-    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt, float t_exit,
-    float seg_next, float seg, float tm, float t_grid, std::uint32_t& grid_j, float& t,
-    glm::vec4& acc, kernel::ResoctRayStats& stats) {
-  return segment_samples_packets_body(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t, acc,
-                                      stats);
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
+    std::uint32_t step_level, float t_exit, float seg_next, float seg, float tm, float t_grid,
+    std::uint32_t& grid_j, float& t, glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  return segment_samples_packets_body(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                      grid_j, t, acc, stats);
 }
 #endif
 
@@ -310,17 +336,18 @@ inline bool segment_packets_avx2() {
 
 // The march's entry (RESOCT_SEGMENT_SAMPLES): the copy this CPU runs fastest.
 inline bool segment_samples_packets(const kernel::ResoctFrame& f, const kernel::ResoctSource& src,
-                                    float dt, float t_exit, float seg_next, float seg, float tm,
-                                    float t_grid, std::uint32_t& grid_j, float& t, glm::vec4& acc,
+                                    float dt, std::uint32_t step_level, float t_exit,
+                                    float seg_next, float seg, float tm, float t_grid,
+                                    std::uint32_t& grid_j, float& t, glm::vec4& acc,
                                     kernel::ResoctRayStats& stats) {
 #ifdef RESOCT_PACKETS_AVX2
   if (segment_packets_avx2()) {
-    return segment_samples_packets_avx2(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t,
-                                        acc, stats);
+    return segment_samples_packets_avx2(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                        grid_j, t, acc, stats);
   }
 #endif
-  return segment_samples_packets_baseline(f, src, dt, t_exit, seg_next, seg, tm, t_grid, grid_j, t,
-                                          acc, stats);
+  return segment_samples_packets_baseline(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                          grid_j, t, acc, stats);
 }
 
 }  // namespace resoct::cpu::detail

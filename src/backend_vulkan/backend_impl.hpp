@@ -51,6 +51,7 @@ enum Binding : std::uint32_t {
   b_cache7 = b_cache1 + 6,
   b_directory,  // the page directory (binding 21)
   b_preint,     // pre-integration tables (binding 22)
+  b_step_luts,  // corrected LUTs of the step levels (binding 23)
   binding_count
 };
 
@@ -112,6 +113,9 @@ struct VulkanBackend::Impl {
   detail::StagingRing ring;
   detail::Buffer readback;  // host-visible: frame results and debug reads
   bool descriptors_dirty = true;
+  // FrameTables::step_luts_version of the step LUTs the device holds (0: none): they are re-sent
+  // only when the tables' version differs (several MiB with many channels) or the buffer is new.
+  std::uint64_t step_luts_on_device = 0;
   bool recording = false;  // `cmd` holds an unsubmitted batch
 
   BackendConfig config{};

@@ -163,6 +163,10 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
          "transfer functions");
   ensure(b_preint, std::max<std::size_t>(tables.preint_tables.size(), 1) * sizeof(glm::vec4),
          "pre-integration tables");
+  const VkBuffer step_luts_before = buf[b_step_luts].buffer;
+  ensure(b_step_luts, std::max<std::size_t>(tables.step_luts.size(), 1) * sizeof(glm::vec4),
+         "step-level LUTs");
+  if (buf[b_step_luts].buffer != step_luts_before) step_luts_on_device = 0;
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   begin_batch();
   // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
@@ -174,6 +178,12 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   stage_copy(buf[b_tf].buffer, 0, std::as_bytes(std::span(tables.tf_luts)));
   if (!tables.preint_tables.empty()) {
     stage_copy(buf[b_preint].buffer, 0, std::as_bytes(std::span(tables.preint_tables)));
+  }
+  // Version 0 (tables not from build_frame_tables) is always sent. render() records the version
+  // only once the frame ran, so a failed submission sends them again.
+  if (!tables.step_luts.empty() &&
+      (tables.step_luts_version == 0 || tables.step_luts_version != step_luts_on_device)) {
+    stage_copy(buf[b_step_luts].buffer, 0, std::as_bytes(std::span(tables.step_luts)));
   }
 }
 

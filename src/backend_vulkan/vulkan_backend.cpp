@@ -185,6 +185,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   m.flush();
   // The pipeline is built by the first render(): compiling the kernel takes seconds on CPU
   // devices, and a configuration that is only updated never needs it.
+  m.step_luts_on_device = 0;
   m.configured = true;
 }
 
@@ -243,8 +244,10 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
   m.write_descriptors();
   // Compiling the kernel is slow (seconds on lavapipe): the cache compiles each variant once.
   const VkPipeline pipeline = m.render_pipelines->get(m.render_variant(tables));
+  m.step_luts_on_device = 0;  // until the frame that sends them has run
   m.record_render(tables, pipeline);
   m.flush();
+  m.step_luts_on_device = tables.step_luts_version;
   invalidate(*m.ctx, m.readback);
   m.read_results(tables.frame, tables.image_to_host, result);
   result.stats.ms_render =

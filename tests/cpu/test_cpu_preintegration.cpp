@@ -90,8 +90,11 @@ TEST(CpuPreintegration, SharpTfAtCoarseStepsIsFarCloserToTheReference) {
 }
 
 // The tubes of the benchmarks with the sharp band: sharp walls in the data limit what a linear
-// value model between samples can do, but coarse steps still gain (measured RMSE point →
-// pre-integrated: step 1 0.017 → 0.009, 2 0.025 → 0.013).
+// value model between samples can do, but coarse steps still gain. A single step scale is an
+// aliasing lottery here (at step 2 the ratio pre-integrated / point ranges 0.65-0.93 between step
+// scales 1.8 and 2.2, and rounding the step to its level moves it), so each group averages five
+// step scales around 1 and 2. Measured mean RMSE point → pre-integrated: ~1: 0.0185 → 0.0097,
+// ~2: 0.0180 → 0.0130 (0.0192 → 0.0130 without step levels).
 TEST(CpuPreintegration, TubesWithSharpTfGainAtCoarseSteps) {
   ProceduralSource src("procedural:tubes:32x32x32:1", bricks8());
   ResidentScene rs(src, {0});
@@ -102,9 +105,14 @@ TEST(CpuPreintegration, TubesWithSharpTfGainAtCoarseSteps) {
   ro.step = 1.0 / 64.0;
   ro.early_termination = false;
   const Image ref = render_reference(scene, src.hierarchy().volume(), level0_voxels(src), ro);
-  for (double step : {1.0, 2.0}) {
-    const Errors e = rmse_at(rs, scene, step, ref);
-    EXPECT_LT(e.preint, 0.7 * e.point) << "step " << step;
+  for (const double centre : {1.0, 2.0}) {
+    double point = 0.0, pre = 0.0;
+    for (const double f : {0.9, 0.95, 1.0, 1.05, 1.1}) {
+      const Errors e = rmse_at(rs, scene, centre * f, ref);
+      point += e.point / 5.0;
+      pre += e.preint / 5.0;
+    }
+    EXPECT_LT(pre, (centre == 1.0 ? 0.6 : 0.8) * point) << "steps around " << centre;
   }
 }
 

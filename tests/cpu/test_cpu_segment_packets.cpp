@@ -1,6 +1,7 @@
 // The CPU backend's segment loop in packets of four samples (src/backend_cpu/segment_packets.hpp)
 // against the single-source loop it replaces (kernel/segment_samples.glsl.h, which the Vulkan
-// backend runs): for random sources, rays, transfer functions, steps, ends and iteration caps,
+// backend runs): for random sources, rays, transfer functions, step levels (full steps from a
+// level's corrected LUT, or none), steps, ends and iteration caps,
 // both must return bit-identical results: saturation, t, the accumulated colour and every
 // statistic, for each compiled copy of the packet loop (baseline and, on x86-64 CPUs that have
 // it, AVX2). A difference of one ulp anywhere would make images depend on the backend's loop.
@@ -31,9 +32,11 @@ using resoct::cpu::detail::KernelContext;
 
 constexpr glm::ivec3 kPadded{10, 9, 7};
 
-using PacketLoop = bool (*)(const k::ResoctFrame&, const k::ResoctSource&, float, float, float,
-                            float, float, float, std::uint32_t&, float&, glm::vec4&,
+using PacketLoop = bool (*)(const k::ResoctFrame&, const k::ResoctSource&, float, std::uint32_t,
+                            float, float, float, float, float, std::uint32_t&, float&, glm::vec4&,
                             k::ResoctRayStats&);
+
+constexpr std::uint32_t kLevels = 3;  // step levels of the fixture's corrected LUTs
 
 // The baseline copy always, the AVX2 copy where the CPU has it and the build made it.
 std::vector<PacketLoop> packet_loops() {
@@ -47,8 +50,9 @@ std::vector<PacketLoop> packet_loops() {
 }  // not cubic: strides and clamps differ per axis
 
 struct Fixture {
-  std::vector<std::byte> cache;  // two slots
-  std::vector<glm::vec4> tf;     // two transfer-function slots
+  std::vector<std::byte> cache;      // two slots
+  std::vector<glm::vec4> tf;         // two transfer-function slots
+  std::vector<glm::vec4> step_luts;  // two slots of kLevels corrected, premultiplied LUTs
   KernelContext ctx;
 };
 
@@ -75,6 +79,14 @@ Fixture make_fixture(std::mt19937& rng, VoxelType type) {
     float a = r < 0.2f ? 0.0f : (r < 0.6f ? u(rng) * 0.05f : (r < 0.95f ? u(rng) : 1.0f));
     e = glm::vec4(u(rng), u(rng), u(rng), a);
   }
+  // Corrected, premultiplied entries (kernel/step_lut.glsl.h) in the same regimes.
+  fx.step_luts.resize(2 * kLevels * k::RESOCT_TF_LUT_SIZE);
+  for (glm::vec4& e : fx.step_luts) {
+    const float r = u(rng);
+    float a = r < 0.2f ? 0.0f : (r < 0.6f ? u(rng) * 0.05f : (r < 0.95f ? u(rng) : 1.0f));
+    e = glm::vec4(u(rng) * a, u(rng) * a, u(rng) * a, a);
+  }
+  fx.ctx.step_luts = fx.step_luts.data();
   fx.ctx.cache = fx.cache.data();
   fx.ctx.slot_voxels = voxels;
   fx.ctx.type = type;
@@ -123,6 +135,9 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
     f.ref_step = 0.002f + u(rng) * 0.01f;
     f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
     f.max_iterations = 40u + std::uint32_t(rng() % 200u);
+    f.step_level_count = kLevels;
+    const std::uint32_t step_level =
+        u(rng) < 0.25f ? k::RESOCT_STEP_LEVEL_NONE : std::uint32_t(rng() % kLevels);
 
     k::ResoctSource src = k::resoct_source_of(k::RESOCT_CH_VALUE, u(rng) * 1.4f - 0.2f);
     if (u(rng) < 0.05f) src.value = std::numeric_limits<float>::quiet_NaN();
@@ -159,13 +174,14 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
     start.stats.marched = u(rng);
 
     Outcome scalar = start;
-    scalar.saturated = k::resoct_segment_samples(f, src, dt, t_exit, seg_next, seg, tm, t_grid,
-                                                 scalar.j, scalar.t, scalar.acc, scalar.stats);
+    scalar.saturated =
+        k::resoct_segment_samples(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                  scalar.j, scalar.t, scalar.acc, scalar.stats);
     // Every compiled copy of the packet loop this CPU can run (the backend picks one).
     for (auto* loop : packet_loops()) {
       Outcome packets = start;
-      packets.saturated = loop(f, src, dt, t_exit, seg_next, seg, tm, t_grid, packets.j, packets.t,
-                               packets.acc, packets.stats);
+      packets.saturated = loop(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid, packets.j,
+                               packets.t, packets.acc, packets.stats);
       expect_identical(scalar, packets, c);
     }
     // The grid index follows t: t is step j of the grid (or the end of the ray's progress).

@@ -219,13 +219,22 @@ TEST(FrameTables, ReusedTablesRecomputeOnlyChangedLutsAndEqualAFreshBuild) {
     s.channels.push_back(ch);
   }
   FrameTables reused;
-  const auto expect_fresh = [&](const char* step, std::uint32_t luts) {
+  std::uint64_t version = 0;
+  // `luts`: transfer-function LUTs recomputed; the step levels' LUTs (and their version, which a
+  // device copy follows) change exactly when some shown slot's LUT or the shown slots change.
+  const auto expect_fresh = [&](const char* step, std::uint32_t luts,
+                                bool step_luts_change = true) {
     build_frame_tables(s, hierarchy, layout, channels, {}, reused);
     const FrameTables fresh = build_frame_tables(s, hierarchy, layout, channels, {});
     EXPECT_EQ(reused.luts_built, luts) << step;
     EXPECT_EQ(fresh.luts_built, std::uint32_t(s.channels.size())) << step;
     EXPECT_EQ(reused.tf_luts, fresh.tf_luts) << step;
     EXPECT_EQ(reused.preint_tables, fresh.preint_tables) << step;
+    EXPECT_GT(reused.frame.step_level_count, 0u) << step;
+    EXPECT_EQ(reused.step_luts, fresh.step_luts) << step;
+    EXPECT_EQ(reused.step_luts_version != version, step_luts_change) << step;
+    EXPECT_NE(fresh.step_luts_version, reused.step_luts_version) << step;
+    version = reused.step_luts_version;
     ASSERT_EQ(reused.slots.size(), fresh.slots.size()) << step;
     EXPECT_EQ(std::memcmp(reused.slots.data(), fresh.slots.data(),
                           fresh.slots.size() * sizeof(kernel::ResoctSlotInfo)),
@@ -235,13 +244,13 @@ TEST(FrameTables, ReusedTablesRecomputeOnlyChangedLutsAndEqualAFreshBuild) {
   };
   expect_fresh("first build", 3);
   s.camera.eye = {1.7, 1.2, 1.5};
-  expect_fresh("camera moved", 0);
+  expect_fresh("camera moved", 0, false);
   s.channels[1].tf = TransferFunction({{0.2, {0, 0, 1, 0}}, {0.9, {1, 1, 1, 0.8}}});
   expect_fresh("one transfer function changed", 1);
   s.preintegration = true;
-  expect_fresh("pre-integration on", 0);
+  expect_fresh("pre-integration on", 0, false);
   s.camera.eye = {1.6, 1.2, 1.5};
-  expect_fresh("camera moved with pre-integration", 0);
+  expect_fresh("camera moved with pre-integration", 0, false);
   s.channels[0].tf = TransferFunction({{0.0, {1, 1, 0, 0}}, {1.0, {1, 1, 0, 0.5}}});
   expect_fresh("transfer function changed with pre-integration", 1);
   const ChannelSettings hidden = s.channels[2];
@@ -251,7 +260,7 @@ TEST(FrameTables, ReusedTablesRecomputeOnlyChangedLutsAndEqualAFreshBuild) {
   s.channels.push_back(hidden);
   expect_fresh("channel 2 shown again", 1);
   s.preintegration = false;
-  expect_fresh("pre-integration off", 0);
+  expect_fresh("pre-integration off", 0, false);
   EXPECT_TRUE(reused.preint_tables.empty());
 }
 

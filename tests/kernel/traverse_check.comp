@@ -38,6 +38,9 @@ layout(std430, binding = 7) readonly buffer TfLuts {
 layout(std430, binding = 21) readonly buffer PreintTables {
   vec4 preint_entries[];
 };
+layout(std430, binding = 22) readonly buffer StepLuts {
+  vec4 step_lut_entries[];
+};
 layout(std430, binding = 8) readonly buffer Cache {
   float cache_voxels[];
 };
@@ -86,6 +89,9 @@ vec4 resoct_read_tf(uint slot, uint index) {
 }
 vec4 resoct_read_preint(uint slot, uint index) {
   return preint_entries[slot * 2048u + index];
+}
+vec4 resoct_read_step_lut(uint index) {
+  return step_lut_entries[index];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;

@@ -22,6 +22,7 @@
 #include "resoct/backend/image.hpp"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/engine/device_records.hpp"
+#include "resoct/scene/step_lut.hpp"
 #include "resoct/scene/transfer_function.hpp"
 #include "resoct/volume/voxel_type.hpp"
 
@@ -95,6 +96,18 @@ struct FrameTables {
   /// preint_tables holds that LUT's pre-integration table. Backends do not read these.
   std::vector<std::optional<TransferFunction>> lut_sources;
   std::vector<std::uint8_t> preint_built;
+  /// Opacity-corrected, premultiplied LUTs of the frame's step levels (kernel/step_lut.glsl.h):
+  /// page_slot_count * frame.step_level_count * RESOCT_TF_LUT_SIZE entries, the LUT of slot s
+  /// and level l at (s * step_level_count + l) * RESOCT_TF_LUT_SIZE; slots not shown read zero.
+  /// They depend on the transfer functions and the step parameters, not on the camera.
+  std::vector<glm::vec4> step_luts;
+  /// Per page slot: whether step_luts holds the slot's tables for its tf_luts entry and the
+  /// frame's levels (build bookkeeping; backends do not read it).
+  std::vector<std::uint8_t> step_luts_built;
+  StepLevels step_levels;  ///< the levels step_luts was built for (bookkeeping)
+  /// Changes (process-wide counter) whenever step_luts does, so that a backend keeping a device
+  /// copy re-sends it only then; equal versions mean equal contents.
+  std::uint64_t step_luts_version = 0;
   /// Transfer-function LUTs the last build computed; the other slots' LUTs were kept.
   std::uint32_t luts_built = 0;
   /// Whether render() must copy the image into host memory (FrameResult::image). When false, a

@@ -85,6 +85,15 @@ RESOCT_FN void resoct_mix_add(RESOCT_INOUT(vec4) weighted, RESOCT_INOUT(float) c
   combined_alpha = combined_alpha + (1.0f - combined_alpha) * alpha;
 }
 
+/// Adds one channel given premultiplied: (rgb · α', α'), as from a step level's LUT
+/// (kernel/step_lut.glsl.h). The same sums as resoct_mix_add with the product precomputed.
+RESOCT_FN void resoct_mix_add_premultiplied(RESOCT_INOUT(vec4) weighted,
+                                            RESOCT_INOUT(float) combined_alpha,
+                                            vec4 premultiplied) {
+  weighted = weighted + premultiplied;
+  combined_alpha = combined_alpha + (1.0f - combined_alpha) * premultiplied.a;
+}
+
 /// The mixed sample, premultiplied.
 RESOCT_FN vec4 resoct_mix_result(vec4 weighted, float combined_alpha) {
   if (!(weighted.a > 0.0f)) return vec4(0.0f);

@@ -134,6 +134,13 @@ struct ResoctFrame {
   float jitter_x;       // sub-pixel offset of every pixel's ray, pixels, in [-0.5, 0.5)
   float jitter_y;       //   (x to the right, y down, like pixel rows)
   float jitter_sample;  // shift of the march's samples along the ray, steps, in [-0.5, 0.5)
+
+  // Step levels and their opacity-corrected LUTs (kernel/step_lut.glsl.h): a ray's full-step
+  // ratio Δ/Δ₀ is rounded down to its bits >> step_level_shift; levels step_level_first ..
+  // + step_level_count - 1 have tables. step_level_count = 0: none (per-sample correction).
+  uint step_level_shift;
+  uint step_level_first;
+  uint step_level_count;
 };
 
 // Effect constants of a frame (kernel/effects.glsl.h; docs/rendering.md "Effects"), a record of

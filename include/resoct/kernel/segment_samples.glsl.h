@@ -19,20 +19,23 @@
 #include "resoct/kernel/composite.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/step.glsl.h"
+#include "resoct/kernel/step_lut.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
 RESOCT_KERNEL_BEGIN
 
 /// Samples `src` (RESOCT_CH_VALUE) from the sample at `tm` (segment [t, t + seg)) while its
-/// midpoint lies before `seg_next`. t is step `grid_j` of the grid that starts at `t_grid`
-/// (resoct_grid_t); grid_j follows t. Returns true when the ray saturated (early termination);
-/// otherwise `t` is the start of the next sample, which the march must see first: the ray's end,
-/// the iteration cap, or a new decision. `acc` is the premultiplied accumulated colour; samples,
-/// brick accesses, iterations and marched length are counted in `stats` as the march's
-/// per-sample path counts them.
+/// midpoint lies before `seg_next`. Full steps (seg == dt) of a ray with a step level
+/// (`step_level`, kernel/step_lut.glsl.h) take their premultiplied, corrected colour from that
+/// level's LUT; shorter ones, and every step without a level, correct per sample. t is step
+/// `grid_j` of the grid that starts at `t_grid` (resoct_grid_t); grid_j follows t. Returns true
+/// when the ray saturated (early termination); otherwise `t` is the start of the next sample, which
+/// the march must see first: the ray's end, the iteration cap, or a new decision. `acc` is the
+/// premultiplied accumulated colour; samples, brick accesses, iterations and marched length are
+/// counted in `stats` as the march's per-sample path counts them.
 RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSource) src, float dt,
-                                           float t_exit, float seg_next, float seg, float tm,
-                                           float t_grid, RESOCT_INOUT(uint) grid_j,
+                                           uint step_level, float t_exit, float seg_next, float seg,
+                                           float tm, float t_grid, RESOCT_INOUT(uint) grid_j,
                                            RESOCT_INOUT(float) t, RESOCT_INOUT(vec4) acc,
                                            RESOCT_INOUT(ResoctRayStats) stats) {
   // The loop's state in locals, written back once: in C++ the references could alias nothing
@@ -54,12 +57,18 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
           resoct_sample_cache(src.cache_slot, src.ray_base + tm * src.ray_dir), src.range_lo,
           src.inv_range_width);
     }
-    vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
-    float alpha = resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step));
     samples = samples + 1u;
     // resoct_mix_result of this one channel: its colour premultiplied (0 where alpha is 0).
-    vec4 sample_pm =
-        alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha) : vec4(0.0f);
+    vec4 sample_pm;
+    if (seg == dt && step_level != RESOCT_STEP_LEVEL_NONE) {
+      vec4 p = resoct_step_lut_lookup(src.tf_slot, step_level, f.step_level_count, value);
+      sample_pm = p.a > 0.0f ? p : vec4(0.0f);
+    } else {
+      vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
+      float alpha = resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step));
+      sample_pm =
+          alpha > 0.0f ? resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), alpha) : vec4(0.0f);
+    }
     a = resoct_composite(a, sample_pm);
     if (resoct_saturated(a, f.ert_opacity)) {
       saturated = true;

@@ -18,6 +18,7 @@
 //   void  resoct_mark_used(uint cache_slot)          the slot was sampled this frame
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
 //   vec4  resoct_read_preint(uint slot, uint index)  (preintegration.glsl.h)
+//   vec4  resoct_read_step_lut(uint index)           (step_lut.glsl.h)
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
 //   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
 //
@@ -50,6 +51,7 @@
 #include "resoct/kernel/segment_samples.glsl.h"
 #include "resoct/kernel/segments.glsl.h"
 #include "resoct/kernel/step.glsl.h"
+#include "resoct/kernel/step_lut.glsl.h"
 #include "resoct/kernel/tf.glsl.h"
 
 RESOCT_KERNEL_BEGIN
@@ -105,6 +107,11 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
 
   vec3 finest = vec3(f.finest_voxel_x, f.finest_voxel_y, f.finest_voxel_z);
   float dt = resoct_step_size(dir_box, finest, f.step_scale, f.min_step);
+  // The full step rounded down to its step level, whose LUT holds the corrected, premultiplied
+  // colours of full steps (kernel/step_lut.glsl.h); without one, every sample corrects itself.
+  uint step_level = resoct_step_level(f, resoct_step_ratio(dt, f.ref_step));
+  if (step_level != RESOCT_STEP_LEVEL_NONE)
+    dt = resoct_step_level_ratio(f, step_level) * f.ref_step;
   uint trav_depth = resoct_traversal_depth(f, dt);
   ResoctSampleParams sp = resoct_sample_params(f);
 
@@ -622,8 +629,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             !skip && seg_values != 0u && (seg_values & (seg_values - 1u)) == 0u && tm < seg_next;
       }
       if (single) {
-        stop = RESOCT_SEGMENT_SAMPLES(f, src[findLSB(seg_values)], dt, t_exit, seg_next, seg, tm,
-                                      t_grid, grid_j, t, acc, stats);
+        stop = RESOCT_SEGMENT_SAMPLES(f, src[findLSB(seg_values)], dt, step_level, t_exit, seg_next,
+                                      seg, tm, t_grid, grid_j, t, acc, stats);
         if (stop) break;
         continue;
       }
@@ -664,9 +671,21 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
             fx_have = fx_have | (1u << c);
           }
           else {
-            vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, src[c].tf_slot, value,
-                                                     resoct_step_ratio(seg, f.ref_step));
-            resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
+            // Full steps of a ray with a step level: the level's corrected, premultiplied LUT
+            // (not with pre-integration, whose tables integrate between two values).
+            bool from_level = seg == dt && step_level != RESOCT_STEP_LEVEL_NONE;
+            RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
+              from_level = false;
+            }
+            if (from_level) {
+              resoct_mix_add_premultiplied(
+                  weighted, combined,
+                  resoct_step_lut_lookup(src[c].tf_slot, step_level, f.step_level_count, value));
+            } else {
+              vec4 rgba = RESOCT_FX(resoct_dvr_sample)(pr, c, src[c].tf_slot, value,
+                                                       resoct_step_ratio(seg, f.ref_step));
+              resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b), rgba.a);
+            }
           }
           any_value = true;
         }

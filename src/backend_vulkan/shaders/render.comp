@@ -71,6 +71,10 @@ layout(std430, binding = 7) readonly buffer TfLuts {
 layout(std430, binding = 22) readonly buffer PreintTables {
   vec4 preint_entries[];
 };
+// Opacity-corrected, premultiplied LUTs of the frame's step levels (kernel/step_lut.glsl.h).
+layout(std430, binding = 23) readonly buffer StepLuts {
+  vec4 step_lut_entries[];
+};
 layout(std430, binding = 8) readonly buffer Cache0 {
   uint cache0[];
 };
@@ -181,6 +185,9 @@ vec4 resoct_read_tf(uint slot, uint index) {
 }
 vec4 resoct_read_preint(uint slot, uint index) {
   return preint_entries[slot * 2048u + index];
+}
+vec4 resoct_read_step_lut(uint index) {
+  return step_lut_entries[index];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;

@@ -2,6 +2,7 @@
 
 #include "resoct/backend/backend.hpp"
 #include "resoct/base/error.hpp"
+#include "resoct/scene/step_lut.hpp"
 #include "resoct/scene/transfer_function.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
@@ -48,6 +49,18 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
   if ((t.fx.effects & kernel::RESOCT_EFFECT_PREINT) != 0u &&
       t.preint_tables.size() != std::size_t(f.page_slot_count) * 2u * kTfLutSize) {
     fail("preint_tables size differs from page_slot_count * 2 * RESOCT_TF_LUT_SIZE");
+  }
+  // Step levels (kernel/step_lut.glsl.h): a shift that keeps the ratio's exponent, and one LUT
+  // per shown-or-not page slot and level.
+  if (f.step_level_count > kMaxStepLevels || f.step_level_shift > 23u ||
+      (f.step_level_count != 0u && (std::uint64_t(f.step_level_first) + f.step_level_count)
+                                           << f.step_level_shift >
+                                       0xFFFFFFFFull)) {
+    fail("step levels out of range");
+  }
+  if (t.step_luts.size() !=
+      std::size_t(f.page_slot_count) * f.step_level_count * std::size_t(kTfLutSize)) {
+    fail("step_luts size differs from page_slot_count * step_level_count * RESOCT_TF_LUT_SIZE");
   }
   if (std::size_t(t.depths.back().first_node) * f.node_slot_count * 4u >= config.node_words + 1u &&
       config.node_words != 0) {

@@ -1,6 +1,7 @@
 #include "resoct/render/frame_tables.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -17,6 +18,7 @@
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/scene/preintegration.hpp"
+#include "resoct/scene/step_lut.hpp"
 #include "resoct/engine/residency_octree.hpp"
 #include "render/frame_tables_slices.hpp"
 
@@ -203,6 +205,57 @@ std::uint32_t lod_floor_level(const Scene& scene, const BrickHierarchy& h) {
   return level;
 }
 
+// A process-wide version for FrameTables::step_luts: each change gets a number no tables had.
+std::uint64_t next_step_luts_version() {
+  static std::atomic<std::uint64_t> counter{0};
+  return ++counter;
+}
+
+// The step levels of the frame (out.frame's step fields) and their corrected LUTs for the shown
+// slots (out.slots, whose tf_luts entries are current); a slot's LUTs are kept while its transfer
+// function and the levels are unchanged, so a camera move recomputes none.
+void build_step_luts(glm::dvec3 finest_voxel, float step_scale, std::uint32_t slot_count,
+                     FrameTables& out) {
+  kernel::ResoctFrame& f = out.frame;
+  const StepLevels levels = step_levels(finest_voxel, double(step_scale), f.min_step, f.ref_step);
+  f.step_level_shift = levels.shift;
+  f.step_level_first = levels.first;
+  f.step_level_count = levels.count;
+  const std::size_t per_slot = std::size_t(levels.count) * kTfLutSize;
+  const bool same_levels = out.step_luts.size() == per_slot * slot_count &&
+                           out.step_luts_built.size() == slot_count && out.step_levels == levels;
+  bool changed = false;
+  if (!same_levels) {
+    out.step_luts.assign(per_slot * slot_count, glm::vec4(0.0f));
+    out.step_luts_built.assign(slot_count, 0u);
+    out.step_levels = levels;
+    changed = true;
+  }
+  for (std::uint32_t slot = 0; slot < slot_count; ++slot) {
+    const auto shown = [slot](const kernel::ResoctSlotInfo& s) { return s.slot == slot; };
+    const bool is_shown = std::any_of(out.slots.begin(), out.slots.end(), shown);
+    const auto first = out.step_luts.begin() + std::ptrdiff_t(slot * per_slot);
+    if (!is_shown) {
+      if (out.step_luts_built[slot] != 0u) {
+        std::fill(first, first + std::ptrdiff_t(per_slot), glm::vec4(0.0f));
+        out.step_luts_built[slot] = 0u;
+        changed = true;
+      }
+      continue;
+    }
+    if (out.step_luts_built[slot] != 0u) continue;
+    const std::span<const glm::vec4> lut(out.tf_luts.data() + std::size_t(slot) * kTfLutSize,
+                                         kTfLutSize);
+    for (std::uint32_t l = 0; l < levels.count; ++l) {
+      step_lut(lut, step_level_ratio(levels, l),
+               std::span<glm::vec4>(&*first + std::size_t(l) * kTfLutSize, kTfLutSize));
+    }
+    out.step_luts_built[slot] = 1u;
+    changed = true;
+  }
+  if (changed || out.step_luts_version == 0) out.step_luts_version = next_step_luts_version();
+}
+
 }  // namespace
 
 void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
@@ -326,6 +379,7 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
       std::copy(fresh.begin(), fresh.end(), lut.begin());
       built_from = c.tf;
       out.preint_built[*slot] = 0u;
+      if (*slot < out.step_luts_built.size()) out.step_luts_built[*slot] = 0u;
       ++out.luts_built;
     }
     fill_slot_zero(c, lut, s);
@@ -365,6 +419,8 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
   // Far below any step a scene can ask for (1e-3 voxels in the tests), but positive.
   f.min_step = float(ref * 0x1p-20);
   f.ref_step = float(ref);
+  build_step_luts(glm::dvec3(f.finest_voxel_x, f.finest_voxel_y, f.finest_voxel_z), f.step_scale,
+                  slot_count, out);
   f.lod_error_px = float(scene.lod_error_px);
   f.ert_opacity = float(scene.ert_opacity);
   f.background_r = float(scene.background.r);

@@ -57,6 +57,9 @@ inline vec4 resoct_read_tf(uint slot, uint index) {
 inline vec4 resoct_read_preint(uint slot, uint index) {
   return test::g.tables->preint_tables[std::size_t(slot) * 2048u + index];
 }
+inline vec4 resoct_read_step_lut(uint index) {
+  return test::g.tables->step_luts[index];
+}
 inline ResoctFxFrame resoct_read_fx_frame() {
   return test::g.tables->fx;
 }

@@ -1,5 +1,6 @@
-// What RESOCT_KERNEL_LAYOUT_VERSION 4 means (2: ResoctFrame gained the jitter; 4:
-// ResoctLevelInfo gained node_depth, the standard-octree mode's culling node): the sizes of the
+// What RESOCT_KERNEL_LAYOUT_VERSION 5 means (2: ResoctFrame gained the jitter; 4:
+// ResoctLevelInfo gained node_depth, the standard-octree mode's culling node; 5: ResoctFrame
+// gained the step levels of kernel/step_lut.glsl.h): the sizes of the
 // records the host shares with the device and the encodings of their packed words. A change to any
 // of them fails here until the version is incremented and this table updated
 // (kernel/layout_version.glsl.h), so applications and backends built against another layout can
@@ -21,10 +22,10 @@ namespace {
 namespace k = resoct::kernel;
 
 TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
-  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 4u)
+  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 5u)
       << "the layout version changed: update the table of this test to the new layout";
   const char* bump = "a shared record changed: increment RESOCT_KERNEL_LAYOUT_VERSION";
-  EXPECT_EQ(sizeof(k::ResoctFrame), 512u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctFrame), 524u) << bump;
   EXPECT_EQ(sizeof(k::ResoctFxFrame), 44u) << bump;
   EXPECT_EQ(sizeof(k::ResoctSlotInfo), 64u) << bump;
   EXPECT_EQ(sizeof(k::ResoctLevelInfo), 44u) << bump;
