@@ -63,7 +63,9 @@ void CpuBackend::configure(const BackendConfig& config) {
   config_ = config;
   voxel_bytes_ = vb;
   slot_voxels_ = slot_voxels;
-  resize_zeroed(cache_, std::size_t(config.cache_slots) * slot_voxels * vb, "brick cache");
+  resize_zeroed(cache_,
+                std::size_t(config.cache_slots) * slot_voxels * vb + detail::kCacheReadSlack,
+                "brick cache");
   resize_zeroed(pages_, std::size_t(config.page_pool_blocks) * kernel::RESOCT_PAGE_BLOCK_ENTRIES,
                 "page pool");
   resize_zeroed(directory_, config.directory_entries, "page directory");

@@ -22,6 +22,10 @@
 
 namespace resoct::cpu::detail {
 
+// Bytes the cache pool holds after its last brick: the AVX2 segment loop reads a pair of u8
+// voxels as one 32-bit word (segment_packets_avx2.hpp), up to two bytes past the pair.
+constexpr std::size_t kCacheReadSlack = 64;
+
 // The padded brick's shape as the trilinear lookup uses it, computed once per render.
 struct BrickGeometry {
   glm::vec3 hi{0.0f};                  // padded - 1: the last voxel centre (minus 0.5) per axis
@@ -178,8 +182,8 @@ inline void resoct_mark_used(uint cache_slot) {
 
 }  // namespace resoct::kernel
 
-// The march's single-channel segment loop as packets of four samples (same arithmetic).
-#include "segment_packets.hpp"
+// The march's single-channel segment loop as packets of four or eight samples (same arithmetic).
+#include "segment_packets_avx2.hpp"
 #define RESOCT_SEGMENT_SAMPLES ::resoct::cpu::detail::segment_samples_packets
 #include "resoct/kernel/traverse.glsl.h"
 

@@ -12,14 +12,13 @@
 // the loop it replaces; tests/cpu/test_cpu_segment_packets.cpp checks that against the
 // single-source loop.
 //
-// On x86-64 the loop is compiled twice: for the baseline (SSE2) and for AVX2 (three-operand
-// forms, blends, 32-bit lane multiplies), chosen once per process from the CPU
-// (__builtin_cpu_supports). The AVX2 copy performs the same IEEE operations in the same order
-// (the target does not include FMA, so nothing is fused), and the test checks both copies against
-// the single-source loop. Sanitizer builds keep the baseline only.
+// On x86-64 an AVX2 copy of eight lanes (segment_packets_avx2.hpp) is chosen once per process
+// when the CPU has it (__builtin_cpu_supports); it performs the same IEEE operations per lane in
+// the same order, and the test checks both copies against the single-source loop. Sanitizer
+// builds keep this baseline only.
 //
-// Included by kernel_access.hpp after the kernel accessors, before kernel/traverse.glsl.h, whose
-// march calls it through RESOCT_SEGMENT_SAMPLES.
+// Included (through segment_packets_avx2.hpp) by kernel_access.hpp after the kernel accessors,
+// before kernel/traverse.glsl.h, whose march calls it through RESOCT_SEGMENT_SAMPLES.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -108,43 +107,138 @@ template <class T>
   return c0 + fz * (c1 - c0);
 }
 
-// kernel::resoct_correct_opacity per lane. The series of both factors run on all lanes; a lane
-// outside a series' range calls the scalar kernel function (its libm branch).
-inline v4f correct_opacity4(v4f alpha, v4f ratio) {
-  using namespace kernel;
-  const v4f one = splat(1.0f);
-  v4f la = -alpha *
-           (one + alpha * (splat(0.5f) +
-                           alpha * (splat(0.33333333f) +
-                                    alpha * (splat(0.25f) +
-                                             alpha * (splat(0.2f) + alpha * splat(0.16666667f))))));
-  const v4i positive = (alpha > splat(0.0f)) & (ratio > splat(0.0f));
-  const v4i valid = positive & ~(alpha >= one);
-  const v4i la_libm = valid & ~(alpha < splat(RESOCT_SERIES_LIMIT));
-  for (int l = 0; l < 4; ++l) {
-    if (la_libm[l] != 0) la[l] = resoct_log_one_minus(alpha[l]);
-  }
-  const v4f y = ratio * la;
-  v4f r =
-      -y *
-      (one + y * (splat(0.5f) + y * (splat(0.16666667f) +
-                                     y * (splat(0.041666668f) +
-                                          y * (splat(0.0083333333f) + y * splat(0.0013888889f))))));
-  const v4i e_libm = valid & ~(y > splat(-RESOCT_SERIES_LIMIT));
-  for (int l = 0; l < 4; ++l) {
-    if (e_libm[l] != 0) r[l] = resoct_one_minus_exp(y[l]);
-  }
-  // glm::clamp(r, 0, 1) = min(max(r, 0), 1) with GLM's (x < y) ? y : x.
-  r = select(r < splat(0.0f), splat(0.0f), r);
-  r = select(one < r, one, r);
-  // Invalid lanes: 1 where the reference alpha is at least 1, else 0.
-  return select(valid, r, select(positive & (alpha >= one), one, splat(0.0f)));
-}
-
 inline v4f load4(const glm::vec4& v) {
   v4f r;
   std::memcpy(&r, &v, sizeof(r));
   return r;
+}
+
+// The loop's running state, read from the march's arguments once and written back once.
+struct PacketLoopState {
+  v4f a;            // accumulated colour, premultiplied
+  float t_now;      // start of the pending sample
+  std::uint32_t j;  // grid step of t_now (kernel::resoct_grid_t)
+  std::uint32_t samples, accesses, iterations;
+  float marched;
+  float tm, seg;  // the pending sample's midpoint and length
+  bool saturated = false;
+};
+
+inline PacketLoopState packet_loop_begin(float seg, float tm, std::uint32_t grid_j, float t,
+                                         const glm::vec4& acc,
+                                         const kernel::ResoctRayStats& stats) {
+  return {load4(acc),    t,  grid_j, stats.samples, stats.brick_accesses, stats.iterations,
+          stats.marched, tm, seg};
+}
+
+inline bool packet_loop_end(const PacketLoopState& s, std::uint32_t& grid_j, float& t,
+                            glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  t = s.t_now;
+  grid_j = s.j;
+  std::memcpy(&acc, &s.a, sizeof(acc));
+  stats.samples = s.samples;
+  stats.brick_accesses = s.accesses;
+  stats.iterations = s.iterations;
+  stats.marched = s.marched;
+  return s.saturated;
+}
+
+// A packet of up to N samples, scheduled exactly as the scalar loop's control would run them if
+// none saturated: lane k starts at lane_t[k], is sampled at lane_tm[k] and is lane_seg[k] long;
+// after lane m - 1 the loop either ends (`ends`, at t_after) or goes on with the pending sample
+// (next_tm, next_seg) that starts at t_after.
+template <int N>
+struct PacketSchedule {
+  float lane_tm[N], lane_seg[N], lane_t[N];
+  int m = 1;
+  bool ends = false;
+  float t_after = 0.0f, next_seg = 0.0f, next_tm = 0.0f;
+};
+
+// The scalar loop's control, one lane at a time from lane `sc.m` on (lanes before it are set).
+template <int N>
+[[gnu::always_inline]] inline void schedule_lanes(const kernel::ResoctFrame& f, float dt,
+                                                  float t_exit, float seg_next, float t_grid,
+                                                  const PacketLoopState& s, PacketSchedule<N>& sc) {
+  using namespace kernel;
+  const float eps_dt = RESOCT_SEGMENT_EPS * dt;
+  for (;;) {
+    sc.t_after = resoct_grid_t(t_grid, s.j + std::uint32_t(sc.m), dt, sc.lane_t[sc.m - 1]);
+    // The scalar loop counts one iteration per sample after the first.
+    if (!(t_exit - sc.t_after > eps_dt) ||
+        s.iterations + std::uint32_t(sc.m - 1) >= f.max_iterations) {
+      sc.ends = true;
+      return;
+    }
+    sc.next_seg = resoct_segment_length(sc.t_after, dt, t_exit);
+    sc.next_tm = sc.t_after + 0.5f * sc.next_seg;
+    if (!(sc.next_tm < seg_next)) {
+      sc.ends = true;
+      return;
+    }
+    if (sc.m == N) return;
+    sc.lane_tm[sc.m] = sc.next_tm;
+    sc.lane_seg[sc.m] = sc.next_seg;
+    sc.lane_t[sc.m] = sc.t_after;
+    ++sc.m;
+  }
+}
+
+// Lane `l`'s premultiplied sample (resoct_mix_result of this one channel) from its normalized
+// value, LUT index i0 and fraction fr: a full step of a ray with a step level from the level's
+// LUT (resoct_step_lut_lookup, 0 where alpha is 0), any other step corrected per sample with the
+// kernel's own functions.
+[[gnu::always_inline]] inline v4f lane_sample(const kernel::ResoctFrame& f,
+                                              const kernel::ResoctSource& src,
+                                              const glm::vec4* level_lut, float dt, float seg,
+                                              float value, bool nan, std::int32_t i0, float fr) {
+  using namespace kernel;
+  if (level_lut != nullptr && seg == dt) {
+    const std::size_t i = nan ? 0u : std::size_t(i0);
+    const v4f p = load4(level_lut[i]) * splat(1.0f - fr) + load4(level_lut[i + 1u]) * splat(fr);
+    return nan || !(p[3] > 0.0f) ? splat(0.0f) : p;
+  }
+  const vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
+  const float al = resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step));
+  return al > 0.0f ? load4(resoct_premultiply(vec3(rgba.r, rgba.g, rgba.b), al)) : splat(0.0f);
+}
+
+// Composites the packet's samples in order with the early-termination test after each, as the
+// scalar loop does, and moves the state past them. Returns true when the loop is over
+// (saturated, or the schedule ends).
+template <int N>
+[[gnu::always_inline]] inline bool composite_lanes(const kernel::ResoctFrame& f, bool mapped,
+                                                   const v4f* pm, const PacketSchedule<N>& sc,
+                                                   PacketLoopState& s) {
+  for (int l = 0; l < sc.m; ++l) {
+    if (mapped) ++s.accesses;
+    ++s.samples;
+    s.a = s.a + splat(1.0f - s.a[3]) * pm[l];
+    if (s.a[3] >= f.ert_opacity) {
+      s.saturated = true;
+      s.t_now = sc.lane_t[l];
+      s.j = s.j + std::uint32_t(l);
+      return true;
+    }
+    s.marched = s.marched + sc.lane_seg[l];
+    if (l + 1 < sc.m) ++s.iterations;
+  }
+  s.t_now = sc.t_after;
+  s.j = s.j + std::uint32_t(sc.m);
+  if (sc.ends) return true;
+  ++s.iterations;
+  s.tm = sc.next_tm;
+  s.seg = sc.next_seg;
+  return false;
+}
+
+// The step level's corrected, premultiplied LUT of the source's slot (kernel/step_lut.glsl.h),
+// or null without a level.
+inline const glm::vec4* level_lut_of(const KernelContext& ctx, const kernel::ResoctFrame& f,
+                                     const kernel::ResoctSource& src, std::uint32_t step_level) {
+  if (step_level == kernel::RESOCT_STEP_LEVEL_NONE) return nullptr;
+  return ctx.step_luts +
+         (std::size_t(src.tf_slot) * f.step_level_count + step_level) * kernel::RESOCT_TF_LUT_SIZE;
 }
 
 // The loop, with kernel::resoct_segment_samples' contract; inlined into each compiled copy.
@@ -157,61 +251,21 @@ inline v4f load4(const glm::vec4& v) {
   const bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
   const std::byte* brick =
       mapped ? ctx.cache + std::size_t(src.cache_slot) * ctx.brick_bytes : nullptr;
-  const glm::vec4* tf = ctx.tf + std::size_t(src.tf_slot) * RESOCT_TF_LUT_SIZE;
-  // The step level's corrected, premultiplied LUT (kernel/step_lut.glsl.h), for full steps.
-  const bool have_level = step_level != RESOCT_STEP_LEVEL_NONE;
-  const glm::vec4* level_lut =
-      have_level ? ctx.step_luts + (std::size_t(src.tf_slot) * f.step_level_count + step_level) *
-                                       RESOCT_TF_LUT_SIZE
-                 : nullptr;
-  const float eps_dt = RESOCT_SEGMENT_EPS * dt;
-
-  v4f a = load4(acc);
-  float t_now = t;
-  std::uint32_t j = grid_j;  // step index of t_now on the grid (kernel::resoct_grid_t)
-  std::uint32_t samples = stats.samples;
-  std::uint32_t accesses = stats.brick_accesses;
-  std::uint32_t iterations = stats.iterations;
-  float marched = stats.marched;
-  bool saturated = false;
-  // The pending sample: midpoint tm, length seg, starting at t_now.
+  const glm::vec4* level_lut = level_lut_of(ctx, f, src, step_level);
+  PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
-    // Schedule up to four samples exactly as the scalar loop's control would run them if none
-    // saturated: lane k starts at lane_t[k]; after the last lane the loop either ends (t_end)
-    // or goes on with a pending fifth sample (next_*).
-    float lane_tm[4], lane_seg[4], lane_t[4];
-    int m = 1;
-    lane_tm[0] = tm;
-    lane_seg[0] = seg;
-    lane_t[0] = t_now;
-    bool ends = false;
-    float t_after = 0.0f, next_seg = 0.0f, next_tm = 0.0f;
-    for (;;) {
-      t_after = resoct_grid_t(t_grid, j + std::uint32_t(m), dt, lane_t[m - 1]);
-      // The scalar loop counts one iteration per sample after the first.
-      if (!(t_exit - t_after > eps_dt) || iterations + std::uint32_t(m - 1) >= f.max_iterations) {
-        ends = true;
-        break;
-      }
-      next_seg = resoct_segment_length(t_after, dt, t_exit);
-      next_tm = t_after + 0.5f * next_seg;
-      if (!(next_tm < seg_next)) {
-        ends = true;
-        break;
-      }
-      if (m == 4) break;
-      lane_tm[m] = next_tm;
-      lane_seg[m] = next_seg;
-      lane_t[m] = t_after;
-      ++m;
-    }
+    PacketSchedule<4> sc;
+    sc.lane_tm[0] = s.tm;
+    sc.lane_seg[0] = s.seg;
+    sc.lane_t[0] = s.t_now;
+    schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
     // Unused lanes repeat lane 0, so that their loads stay inside the brick.
-    for (int l = m; l < 4; ++l) {
-      lane_tm[l] = lane_tm[0];
-      lane_seg[l] = lane_seg[0];
+    for (int l = sc.m; l < 4; ++l) {
+      sc.lane_tm[l] = sc.lane_tm[0];
+      sc.lane_seg[l] = sc.lane_seg[0];
     }
 
-    const v4f tmv{lane_tm[0], lane_tm[1], lane_tm[2], lane_tm[3]};
+    const v4f tmv{sc.lane_tm[0], sc.lane_tm[1], sc.lane_tm[2], sc.lane_tm[3]};
     v4f value = splat(src.value);
     if (mapped) {
       const v4f px = splat(src.ray_base.x) + tmv * splat(src.ray_dir.x);
@@ -227,7 +281,7 @@ inline v4f load4(const glm::vec4& v) {
       }
       value = (raw - splat(src.range_lo)) * splat(src.inv_range_width);
     }
-    // resoct_tf_lookup: clamp (GLM's min(max(v, 0), 1)), index, lerp of two entries.
+    // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
     const v4i nan = value != value;
     v4f x = select(value < splat(0.0f), splat(0.0f), value);
     x = select(splat(1.0f) < x, splat(1.0f), x) * splat(float(RESOCT_TF_LUT_SIZE - 1u));
@@ -235,75 +289,14 @@ inline v4f load4(const glm::vec4& v) {
     const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
     i0 = select(splat(last) < i0, splat(last), i0);
     const v4f fr = x - __builtin_convertvector(i0, v4f);
-    // Each lane's premultiplied sample (resoct_mix_result of this one channel): full steps of a
-    // ray with a step level from the level's LUT (resoct_step_lut_lookup, 0 where alpha is 0),
-    // the others (the last, shorter step) corrected per sample.
     v4f pm[4];
-    bool per_sample = !have_level;
-    for (int l = 0; l < m; ++l) per_sample = per_sample || lane_seg[l] != dt;
-    if (per_sample) {
-      v4f rgba[4];
-      v4f alpha;
-      for (int l = 0; l < 4; ++l) {
-        // glm::mix(a, b, f) = a * (1 - f) + b * f, per component.
-        const std::size_t i = nan[l] != 0 ? 0u : std::size_t(i0[l]);
-        rgba[l] = load4(tf[i]) * splat(1.0f - fr[l]) + load4(tf[i + 1u]) * splat(fr[l]);
-        if (nan[l] != 0) rgba[l] = splat(0.0f);
-        alpha[l] = rgba[l][3];
-      }
-      // kernel::resoct_step_ratio per lane.
-      const v4f ratio =
-          v4f{lane_seg[0], lane_seg[1], lane_seg[2], lane_seg[3]} * splat(1.0f / f.ref_step);
-      const v4f corrected = correct_opacity4(alpha, ratio);
-      for (int l = 0; l < 4; ++l) {
-        const float al = corrected[l];
-        pm[l] = splat(0.0f);
-        if (al > 0.0f) {
-          pm[l] = rgba[l] * splat(al);
-          pm[l][3] = al;
-        }
-      }
+    for (int l = 0; l < sc.m; ++l) {
+      pm[l] =
+          lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
     }
-    if (have_level) {
-      for (int l = 0; l < m; ++l) {
-        if (lane_seg[l] != dt) continue;
-        const std::size_t i = nan[l] != 0 ? 0u : std::size_t(i0[l]);
-        v4f p = load4(level_lut[i]) * splat(1.0f - fr[l]) + load4(level_lut[i + 1u]) * splat(fr[l]);
-        if (nan[l] != 0 || !(p[3] > 0.0f)) p = splat(0.0f);
-        pm[l] = p;
-      }
-    }
-
-    // Composite in order, as the scalar loop does.
-    for (int l = 0; l < m; ++l) {
-      if (mapped) ++accesses;
-      ++samples;
-      a = a + splat(1.0f - a[3]) * pm[l];
-      if (a[3] >= f.ert_opacity) {
-        saturated = true;
-        t_now = lane_t[l];
-        j = j + std::uint32_t(l);
-        break;
-      }
-      marched = marched + lane_seg[l];
-      if (l + 1 < m) ++iterations;
-    }
-    if (saturated) break;
-    t_now = t_after;
-    j = j + std::uint32_t(m);
-    if (ends) break;
-    ++iterations;
-    tm = next_tm;
-    seg = next_seg;
+    if (composite_lanes(f, mapped, pm, sc, s)) break;
   }
-  t = t_now;
-  grid_j = j;
-  std::memcpy(&acc, &a, sizeof(acc));
-  stats.samples = samples;
-  stats.brick_accesses = accesses;
-  stats.iterations = iterations;
-  stats.marched = marched;
-  return saturated;
+  return packet_loop_end(s, grid_j, t, acc, stats);
 }
 
 // The compiled copies, kept out of the march (noinline) like the loop they replace.
@@ -314,16 +307,6 @@ inline v4f load4(const glm::vec4& v) {
   return segment_samples_packets_body(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
                                       grid_j, t, acc, stats);
 }
-#ifdef RESOCT_PACKETS_AVX2
-[[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
-    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
-    std::uint32_t step_level, float t_exit, float seg_next, float seg, float tm, float t_grid,
-    std::uint32_t& grid_j, float& t, glm::vec4& acc, kernel::ResoctRayStats& stats) {
-  return segment_samples_packets_body(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
-                                      grid_j, t, acc, stats);
-}
-#endif
-
 /// Whether this process runs the AVX2 copy of the loop.
 inline bool segment_packets_avx2() {
 #ifdef RESOCT_PACKETS_AVX2
@@ -332,22 +315,6 @@ inline bool segment_packets_avx2() {
 #else
   return false;
 #endif
-}
-
-// The march's entry (RESOCT_SEGMENT_SAMPLES): the copy this CPU runs fastest.
-inline bool segment_samples_packets(const kernel::ResoctFrame& f, const kernel::ResoctSource& src,
-                                    float dt, std::uint32_t step_level, float t_exit,
-                                    float seg_next, float seg, float tm, float t_grid,
-                                    std::uint32_t& grid_j, float& t, glm::vec4& acc,
-                                    kernel::ResoctRayStats& stats) {
-#ifdef RESOCT_PACKETS_AVX2
-  if (segment_packets_avx2()) {
-    return segment_samples_packets_avx2(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
-                                        grid_j, t, acc, stats);
-  }
-#endif
-  return segment_samples_packets_baseline(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
-                                          grid_j, t, acc, stats);
 }
 
 }  // namespace resoct::cpu::detail

@@ -1,0 +1,221 @@
+#pragma once
+// Internal to resoct::cpu: the AVX2 copy of the segment loop (segment_packets.hpp), eight
+// samples per packet.
+//
+// The same contract and, lane by lane, the same IEEE operations in the same order as the
+// single-source loop (kernel/segment_samples.glsl.h), so t, colours and statistics are
+// bit-identical to it (tests/cpu/test_cpu_segment_packets.cpp); what differs from the four-lane
+// baseline copy is how the work is spread:
+//   - the schedule of a packet is computed for all eight lanes at once: step k of the grid is
+//     t_grid + float(j + k) * dt (resoct_grid_t) wherever those values strictly increase, which
+//     is checked, and the scalar schedule runs where they do not (steps below an ulp of t);
+//   - the eight trilinear footprints are read with gathers, two voxels per 32-bit word for u8
+//     and u16 (x and x + 1 are adjacent), and interpolated eight lanes wide;
+//   - the transfer function, the opacity correction and compositing stay per lane, in order.
+// The target does not include FMA, so no multiply-add is contracted. Reading a u8 pair as a
+// 32-bit word reads up to two bytes past the pair: the backend's cache pool has
+// kCacheReadSlack bytes of slack after its last brick.
+#include <immintrin.h>
+
+#include <cstddef>
+#include <cstdint>
+
+#include "segment_packets.hpp"
+
+namespace resoct::cpu::detail {
+
+#ifdef RESOCT_PACKETS_AVX2
+
+using v8f = float __attribute__((vector_size(32)));
+using v8i = std::int32_t __attribute__((vector_size(32)));
+
+[[gnu::target("avx2")]] inline v8f splat8(float x) {
+  return v8f{x, x, x, x, x, x, x, x};
+}
+[[gnu::target("avx2")]] inline v8i splat8(std::int32_t x) {
+  return v8i{x, x, x, x, x, x, x, x};
+}
+[[gnu::target("avx2")]] inline v8f select8(v8i mask, v8f a, v8f b) {
+  return v8f((mask & v8i(a)) | (~mask & v8i(b)));
+}
+[[gnu::target("avx2")]] inline v8i select8(v8i mask, v8i a, v8i b) {
+  return (mask & a) | (~mask & b);
+}
+// clamp_coord (kernel_access.hpp) per lane: [0, hi], NaN to 0.
+[[gnu::target("avx2")]] inline v8f clamp_coord8(v8f v, float hi) {
+  const v8f h = splat8(hi);
+  return select8(v > splat8(0.0f), select8(v < h, v, h), splat8(0.0f));
+}
+// 32-bit words at byte offsets `off` from `base`.
+[[gnu::target("avx2")]] inline v8i gather_words(const std::byte* base, v8i off) {
+  return v8i(_mm256_i32gather_epi32(reinterpret_cast<const int*>(base), __m256i(off), 1));
+}
+
+// The voxel pairs (x0, x0 + 1) of one row of the eight footprints, as floats: `off` is the
+// byte offset of voxel x0. u8 and u16 read both from one word (dx = 1 voxel), f32 two words.
+template <class T>
+[[gnu::target("avx2"), gnu::always_inline]] inline void gather_pair(const std::byte* brick, v8i off,
+                                                                    v8f& lo, v8f& hi) {
+  if constexpr (sizeof(T) == 4) {
+    lo = v8f(gather_words(brick, off));
+    hi = v8f(gather_words(brick, off + splat8(4)));
+  } else {
+    const v8i w = gather_words(brick, off);
+    constexpr std::int32_t mask = sizeof(T) == 1 ? 0xFF : 0xFFFF;
+    constexpr int shift = 8 * int(sizeof(T));
+    lo = __builtin_convertvector(w & splat8(mask), v8f);
+    hi = __builtin_convertvector((w >> shift) & splat8(mask), v8f);
+  }
+}
+
+// trilinear<T> (kernel_access.hpp) at eight positions: the same clamps, cell and lerps per lane.
+// Needs dx == 1 (the padded brick is more than one voxel wide).
+template <class T>
+[[gnu::target("avx2"), gnu::always_inline]] inline v8f trilinear8(const std::byte* brick,
+                                                                  const BrickGeometry& g, v8f px,
+                                                                  v8f py, v8f pz) {
+  const v8f cx = clamp_coord8(px - splat8(0.5f), g.hi.x);
+  const v8f cy = clamp_coord8(py - splat8(0.5f), g.hi.y);
+  const v8f cz = clamp_coord8(pz - splat8(0.5f), g.hi.z);
+  v8i x0 = __builtin_convertvector(cx, v8i);
+  v8i y0 = __builtin_convertvector(cy, v8i);
+  v8i z0 = __builtin_convertvector(cz, v8i);
+  x0 = select8(splat8(g.last_cell.x) < x0, splat8(g.last_cell.x), x0);
+  y0 = select8(splat8(g.last_cell.y) < y0, splat8(g.last_cell.y), y0);
+  z0 = select8(splat8(g.last_cell.z) < z0, splat8(g.last_cell.z), z0);
+  const v8f fx = cx - __builtin_convertvector(x0, v8f);
+  const v8f fy = cy - __builtin_convertvector(y0, v8f);
+  const v8f fz = cz - __builtin_convertvector(z0, v8f);
+  const std::int32_t size = std::int32_t(sizeof(T));
+  const v8i i =
+      (z0 * splat8(std::int32_t(g.slice)) + y0 * splat8(std::int32_t(g.row)) + x0) * splat8(size);
+  const v8i dy = splat8(std::int32_t(g.dy) * size), dz = splat8(std::int32_t(g.dz) * size);
+  v8f v000, v100, v010, v110, v001, v101, v011, v111;
+  gather_pair<T>(brick, i, v000, v100);
+  gather_pair<T>(brick, i + dy, v010, v110);
+  gather_pair<T>(brick, i + dz, v001, v101);
+  gather_pair<T>(brick, i + dz + dy, v011, v111);
+  const v8f c00 = v000 + fx * (v100 - v000);
+  const v8f c10 = v010 + fx * (v110 - v010);
+  const v8f c01 = v001 + fx * (v101 - v001);
+  const v8f c11 = v011 + fx * (v111 - v011);
+  const v8f c0 = c00 + fy * (c10 - c00);
+  const v8f c1 = c01 + fy * (c11 - c01);
+  return c0 + fz * (c1 - c0);
+}
+
+// The loop in packets of eight, with kernel::resoct_segment_samples' contract.
+[[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
+    const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
+    std::uint32_t step_level, float t_exit, float seg_next, float seg, float tm, float t_grid,
+    std::uint32_t& grid_j, float& t, glm::vec4& acc, kernel::ResoctRayStats& stats) {
+  using namespace kernel;
+  const KernelContext& ctx = *t_ctx;
+  const bool mapped = src.cache_slot != RESOCT_SOURCE_NO_SLOT;
+  // Gathers need x + 1 next to x; a one-voxel-wide padded brick takes the four-lane copy.
+  if (mapped && ctx.geometry.dx != 1u) {
+    return segment_samples_packets_baseline(f, src, dt, step_level, t_exit, seg_next, seg, tm,
+                                            t_grid, grid_j, t, acc, stats);
+  }
+  const std::byte* brick =
+      mapped ? ctx.cache + std::size_t(src.cache_slot) * ctx.brick_bytes : nullptr;
+  const glm::vec4* level_lut = level_lut_of(ctx, f, src, step_level);
+  const float eps_dt = RESOCT_SEGMENT_EPS * dt;
+  const v8f lane_index{1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f, 8.0f};
+  PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
+  for (;;) {
+    PacketSchedule<8> sc;
+    sc.lane_tm[0] = s.tm;
+    sc.lane_seg[0] = s.seg;
+    sc.lane_t[0] = s.t_now;
+    // Steps j + 1 .. j + 8 at once (resoct_grid_t: float(j + k) * dt, then + t_grid; j + 8 is
+    // exact in float far beyond any iteration cap). Where they do not strictly increase (steps
+    // below an ulp of t), resoct_grid_t's guard decides: the scalar schedule runs.
+    const v8f starts = splat8(t_grid) + (splat8(float(s.j)) + lane_index) * splat8(dt);
+    bool increasing = starts[0] > s.t_now && float(s.j) + 8.0f < 16777216.0f;
+    for (int k = 1; k < 8; ++k) increasing = increasing && starts[k] > starts[k - 1];
+    if (increasing) {
+      // resoct_segment_length: max(min(dt, t_exit - t), 0) with GLM's min (y < x ? y : x) and
+      // max (x < y ? y : x).
+      const v8f rest = splat8(t_exit) - starts;
+      const v8f segs = select8(rest < splat8(dt), rest, splat8(dt));
+      const v8f seg_len = select8(segs < splat8(0.0f), splat8(0.0f), segs);
+      const v8f mids = starts + splat8(0.5f) * seg_len;
+      for (int k = 1; k <= 8; ++k) {
+        sc.t_after = starts[k - 1];
+        if (!(t_exit - sc.t_after > eps_dt) ||
+            s.iterations + std::uint32_t(k - 1) >= f.max_iterations || !(mids[k - 1] < seg_next)) {
+          sc.ends = true;
+          break;
+        }
+        sc.next_seg = seg_len[k - 1];
+        sc.next_tm = mids[k - 1];
+        if (k == 8) break;
+        sc.lane_tm[k] = sc.next_tm;
+        sc.lane_seg[k] = sc.next_seg;
+        sc.lane_t[k] = sc.t_after;
+        sc.m = k + 1;
+      }
+    } else {
+      schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
+    }
+    // Unused lanes repeat lane 0, so that their reads stay inside the brick.
+    for (int l = sc.m; l < 8; ++l) {
+      sc.lane_tm[l] = sc.lane_tm[0];
+      sc.lane_seg[l] = sc.lane_seg[0];
+    }
+
+    v8f tmv;
+    for (int l = 0; l < 8; ++l) tmv[l] = sc.lane_tm[l];
+    v8f value = splat8(src.value);
+    if (mapped) {
+      const v8f px = splat8(src.ray_base.x) + tmv * splat8(src.ray_dir.x);
+      const v8f py = splat8(src.ray_base.y) + tmv * splat8(src.ray_dir.y);
+      const v8f pz = splat8(src.ray_base.z) + tmv * splat8(src.ray_dir.z);
+      v8f raw;
+      switch (ctx.type) {
+        case VoxelType::u8: raw = trilinear8<std::uint8_t>(brick, ctx.geometry, px, py, pz); break;
+        case VoxelType::u16:
+          raw = trilinear8<std::uint16_t>(brick, ctx.geometry, px, py, pz);
+          break;
+        default: raw = trilinear8<float>(brick, ctx.geometry, px, py, pz); break;
+      }
+      value = (raw - splat8(src.range_lo)) * splat8(src.inv_range_width);
+    }
+    // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
+    const v8i nan = value != value;
+    v8f x = select8(value < splat8(0.0f), splat8(0.0f), value);
+    x = select8(splat8(1.0f) < x, splat8(1.0f), x) * splat8(float(RESOCT_TF_LUT_SIZE - 1u));
+    v8i i0 = __builtin_convertvector(x, v8i);
+    const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
+    i0 = select8(splat8(last) < i0, splat8(last), i0);
+    const v8f fr = x - __builtin_convertvector(i0, v8f);
+    v4f pm[8];
+    for (int l = 0; l < sc.m; ++l) {
+      pm[l] =
+          lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
+    }
+    if (composite_lanes(f, mapped, pm, sc, s)) break;
+  }
+  return packet_loop_end(s, grid_j, t, acc, stats);
+}
+
+#endif  // RESOCT_PACKETS_AVX2
+
+// The march's entry (RESOCT_SEGMENT_SAMPLES): the copy this CPU runs fastest.
+inline bool segment_samples_packets(const kernel::ResoctFrame& f, const kernel::ResoctSource& src,
+                                    float dt, std::uint32_t step_level, float t_exit,
+                                    float seg_next, float seg, float tm, float t_grid,
+                                    std::uint32_t& grid_j, float& t, glm::vec4& acc,
+                                    kernel::ResoctRayStats& stats) {
+#ifdef RESOCT_PACKETS_AVX2
+  if (segment_packets_avx2()) {
+    return segment_samples_packets_avx2(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                        grid_j, t, acc, stats);
+  }
+#endif
+  return segment_samples_packets_baseline(f, src, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                                          grid_j, t, acc, stats);
+}
+
+}  // namespace resoct::cpu::detail
