@@ -7,7 +7,8 @@ on the same sphere volume, camera and transfer function.
 
 Both render procedural:sphere at --size³ (float32, v = max(0, 1 - r / R) at voxel centres, the
 formula of src/core/sources/procedural/analytic.cpp SphereField evaluated in double and rounded to float
-once, as ProceduralSource stores f32 voxels) with the camera, viewport and transfer function of
+once, as ProceduralSource stores f32 voxels; with --type u8, round(255 v) as unsigned bytes, which
+resoct reads from a brick store made by resoct-convert) with the camera, viewport and transfer function of
 examples/scenes/sphere.json, on --threads threads. VTK: trilinear interpolation, no shading,
 sample distance and scalar-opacity unit distance one voxel (resoct's TF alpha is the opacity of
 one voxel), no automatic sample-distance adjustment, one ray per pixel. resoct: resoct-render
@@ -43,6 +44,12 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--size", type=int, default=256, help="sphere extent per axis (voxels)")
+    p.add_argument("--type", choices=["f32", "u8"], default="f32",
+                   help="voxel type: f32 (procedural:sphere itself) or u8 (the sphere rounded to "
+                        "round(255 v), converted to a brick store with resoct-convert; the "
+                        "issue's volume)")
+    p.add_argument("--resoct-convert",
+                   default=os.path.join(ROOT, "build/release/examples/resoct-convert"))
     p.add_argument("--scene", default=os.path.join(ROOT, "examples/scenes/sphere.json"))
     p.add_argument("--frames", type=int, default=10, help="timed frames (each renderer)")
     p.add_argument("--warmup", type=int, default=2, help="untimed VTK frames first")
@@ -106,16 +113,20 @@ def render_vtk(vol, scene, args, png):
     image.SetDimensions(n, n, n)
     image.SetSpacing(h, h, h)
     image.SetOrigin(0.5 * h, 0.5 * h, 0.5 * h)  # VTK points are voxel centres: (i + 0.5) / n
+    u8 = vol.dtype == np.uint8
     scalars = numpy_support.numpy_to_vtk(vol.ravel(order="C"), deep=True,
-                                         array_type=vtk.VTK_FLOAT)
+                                         array_type=vtk.VTK_UNSIGNED_CHAR if u8 else vtk.VTK_FLOAT)
     image.GetPointData().SetScalars(scalars)
 
     channel = scene["channels"][0]
     colour = vtk.vtkColorTransferFunction()
     opacity = vtk.vtkPiecewiseFunction()
-    for value, r, g, b, a in channel["tf"]:  # normalized values; f32 range is [0, 1]
-        colour.AddRGBPoint(value, r, g, b)
-        opacity.AddPoint(value, a)
+    # The TF's points are normalized values: resoct maps f32 [0, 1] and u8 [0, 255] (the type's
+    # range, resoct-convert's default for raw u8) to [0, 1].
+    scale = 255.0 if u8 else 1.0
+    for value, r, g, b, a in channel["tf"]:
+        colour.AddRGBPoint(value * scale, r, g, b)
+        opacity.AddPoint(value * scale, a)
 
     prop = vtk.vtkVolumeProperty()
     prop.SetColor(colour)
@@ -266,8 +277,21 @@ def main():
     load_before = load_avg()
 
     vol = sphere_volume(n)
+    if args.type == "u8":
+        # The u8 sphere: round(255 v), written raw and converted to a brick store, which
+        # resoct opens like a user's file (level-0 leaves scanned as bricks load).
+        vol = np.rint(vol.astype(np.float64) * 255.0).astype(np.uint8)
+        raw_path = os.path.join(args.work, f"sphere_{n}_u8.raw")
+        with open(raw_path, "wb") as f:
+            f.write(vol.tobytes(order="C"))
+        spec = os.path.join(args.work, f"sphere_{n}_u8.rbs")
+        subprocess.run([args.resoct_convert, raw_path, spec, "--dims", f"{n}x{n}x{n}", "--type",
+                        "u8"], check=True, stdout=subprocess.DEVNULL)
     raw = vol.tobytes(order="C")
-    volume_info = {"spec": spec, "type": "f32", "sha256": hashlib.sha256(raw).hexdigest()}
+    volume_info = {"spec": rel(spec), "type": args.type,
+                   "sha256": hashlib.sha256(raw).hexdigest()}
+    if args.verify_raw and args.type == "u8":
+        raise SystemExit("vtk_raycast.py: --verify-raw checks the f32 sphere only")
     if args.verify_raw:
         with open(args.verify_raw, "rb") as f:
             ref = f.read()
