@@ -31,6 +31,7 @@
 // Sizes: 128³ with 128² images, frame cap 24 (standard); 512³, 512², cap 128 (--large);
 // 48³, 32², cap 8 (--smoke).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -38,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "resoct/render/renderer_inspection.hpp"
 #include "resoct/volume/dense_volume.hpp"
 #include "resoct/sources/in_memory_source.hpp"
 #include "support/bench_rig.hpp"
@@ -167,6 +169,104 @@ BENCHMARK(BM_OutOfCore)
       }
     })
     ->ArgNames({"dataset", "strategy", "cache_div", "budget"})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Eviction policies on a moving camera (issue 17): one Renderer follows a path of positions 20
+// degrees apart on a circle about the up axis, out to 160 degrees and back to 0 (17 positions,
+// the way back revisiting what the way out loaded), the camera 0.8 box units from the centre so
+// that each view sees part of the volume at fine levels, and renders each position until it
+// converges (frame cap per position). The device cache holds `cache_pct` % of the path's distinct
+// bricks (those a run with a cache of every brick uploads), so the path does not fit. Greedy
+// requests, 256 bricks per frame, the default 1 GiB host cache (it keeps every loaded brick, so
+// evictions cost uploads, not source reads). Counters summed over the path: frames, positions
+// that converged, bricks and MiB uploaded, evictions, ms (wall, all frames).
+//   BM_EvictionPath/dataset:<d>/policy:<p>/cache_pct:<c>
+//     p = 0 lru, 1 octreemizer (published: neighbourhood distance to the wish list tree),
+//         2 octreemizer-camera (distance from the eye); c = 50, 75
+struct PathRun {
+  std::uint64_t frames = 0, converged = 0, uploaded = 0, bytes = 0, evictions = 0;
+  double ms = 0.0;
+};
+
+std::vector<double> path_degrees() {
+  std::vector<double> path;
+  for (int i = 0; i <= 8; ++i) path.push_back(double(i) * 20.0);
+  for (int i = 7; i >= 0; --i) path.push_back(double(i) * 20.0);
+  return path;
+}
+
+PathRun run_path(const Dataset& ds, int d, const RendererOptions& o) {
+  using Clock = std::chrono::steady_clock;
+  PathRun run;
+  Renderer renderer(ds.source, o);
+  const auto start = Clock::now();
+  for (const double deg : path_degrees()) {
+    Scene scene = source_scene(ds.source->volume(), kCopies[d], image_size(), kCopies[d] > 1);
+    const double a = deg * 3.14159265358979323846 / 180.0;
+    scene.camera.eye = scene.camera.target + glm::dvec3(0.8 * std::sin(a), 0.1, 0.8 * std::cos(a));
+    for (std::uint32_t f = 0; f < frame_cap(); ++f) {
+      const FrameReport report = renderer.render_frame(scene);
+      ++run.frames;
+      run.uploaded += report.stats.bricks_uploaded;
+      run.bytes += report.stats.bytes_uploaded;
+      run.evictions += report.stats.evictions;
+      if (report.converged) {
+        ++run.converged;
+        break;
+      }
+    }
+  }
+  run.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  return run;
+}
+
+void BM_EvictionPath(benchmark::State& state) {
+  const int d = int(state.range(0));
+  constexpr Eviction kPolicies[] = {Eviction::lru, Eviction::octreemizer,
+                                    Eviction::octreemizer_camera};
+  const Eviction policy = kPolicies[state.range(1)];
+  const auto pct = std::uint64_t(state.range(2));
+  const Dataset& ds = dataset_for(d);
+  // The path's distinct bricks: every upload of a run whose cache holds every brick.
+  static std::map<int, std::uint64_t> path_bricks;
+  if (!path_bricks.contains(d)) {
+    const BrickHierarchy& h = ds.source->hierarchy();
+    const std::uint64_t every = h.bricks_per_channel() * h.volume().channels;
+    path_bricks[d] =
+        run_path(ds, d,
+                 options_for(std::min(every * ds.baseline.brick_bytes, std::uint64_t(1) << 30), 256,
+                             RequestStrategy::greedy))
+            .uploaded;
+  }
+  const std::uint64_t slots = std::max<std::uint64_t>(1, path_bricks[d] * pct / 100);
+  RendererOptions o = options_for(slots * ds.baseline.brick_bytes, 256, RequestStrategy::greedy);
+  o.eviction = policy;
+  PathRun run;
+  for (auto _ : state) run = run_path(ds, d, o);
+  state.counters["frames"] = double(run.frames);
+  state.counters["positions"] = double(path_degrees().size());
+  state.counters["converged"] = double(run.converged);
+  state.counters["bricks_uploaded"] = double(run.uploaded);
+  state.counters["MiB_uploaded"] = double(run.bytes) / double(1 << 20);
+  state.counters["evictions"] = double(run.evictions);
+  state.counters["cache_slots"] = double(slots);
+  state.counters["path_bricks"] = double(path_bricks[d]);
+  state.counters["ms_path"] = run.ms;
+  state.SetLabel(std::string(kNames[d]) + "/" + to_string(policy) + "/cache " +
+                 std::to_string(pct) + "% of the path");
+}
+
+BENCHMARK(BM_EvictionPath)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      for (int d = 0; d < 2; ++d) {
+        for (int pct : {50, 75}) {
+          for (int p = 0; p < 3; ++p) b->Args({d, p, pct});
+        }
+      }
+    })
+    ->ArgNames({"dataset", "policy", "cache_pct"})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

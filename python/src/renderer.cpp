@@ -148,8 +148,10 @@ void bind_renderer(py::module_& m) {
            "backend: 'cpu' (threads: 0 = all cores) or 'vulkan' (device: index or name "
            "substring, '' = best; validation: Khronos validation layers). loader_threads: None "
            "= one per core, 0 = load inside render calls (deterministic). mode: residency, "
-           "pagetable or octree; strategy: greedy or global; eviction, host_eviction: lru or "
-           "octreemizer; output: rgba32f, rgba8 or both; prefetch_frames: camera lookahead.")
+           "pagetable or octree; strategy: greedy or global; eviction, host_eviction: lru, "
+           "octreemizer (the published priority: distance to the wish list) or "
+           "octreemizer-camera (distance from the eye); output: rgba32f, rgba8 or both; "
+           "prefetch_frames: camera lookahead.")
       .def("render_frame", &render_frame, py::arg("scene"),
            "Renders one frame of a Scene (or scene dict) and returns a Frame.")
       .def("render_until_converged", &render_until_converged, py::arg("scene"),

@@ -11,10 +11,13 @@ namespace resoct {
 
 /// The eviction policies a renderer's caches can use (RendererOptions::eviction, host_eviction).
 enum class Eviction : std::uint8_t {
-  lru,          ///< LruPolicy
-  octreemizer,  ///< OctreemizerPolicy, distances from the current camera
+  lru,  ///< LruPolicy
+  /// OctreemizerPolicy as published: d = neighbourhood distance in bricks to the wish list tree
+  /// of the last frame (WishListDistance)
+  octreemizer,
+  octreemizer_camera,  ///< OctreemizerPolicy with d = distance from the current camera
 };
-/// "lru" / "octreemizer".
+/// "lru" / "octreemizer" / "octreemizer-camera".
 const char* to_string(Eviction e) noexcept;
 /// The inverse of to_string; throws Error(invalid_argument) naming `parameter` otherwise.
 Eviction parse_eviction(std::string_view s, std::string_view parameter = "eviction");

@@ -52,6 +52,10 @@ class EvictionPolicy {
   /// An unpinned resident slot to evict, or nullopt when every resident slot is pinned.
   virtual std::optional<std::uint32_t> victim(const PinState& pins) = 0;
   virtual std::string_view name() const noexcept = 0;
+  /// What the policy's distances are measured to changed (a new wish list, a camera move): a
+  /// policy that ranks by distance re-reads every resident slot's distance before its next
+  /// victim. No-op for the others.
+  virtual void distances_changed() {}
 };
 
 /// Least recently used: an intrusive doubly-linked list in use order. Touch, insert, remove O(1);
@@ -84,8 +88,11 @@ class LruPolicy final : public EvictionPolicy {
 /// Octreemizer discard priority p = ka * age + kl * depth + kd * distance; the slot with the
 /// largest p is evicted. age = frames since last use; depth = (level_count - 1) - level, i.e. 0
 /// for the coarsest level, so that like the Octreemizer's octree level it grows towards finer
-/// data and finer bricks go first; distance = camera to brick centre in whatever unit the caller
-/// uses (the Octreemizer measured it in bricks). Defaults are the paper's ka = 1, kl = 16, kd = 1.
+/// data and finer bricks go first; distance = whatever the policy's DistanceFn returns: the
+/// published one is the neighbourhood distance in bricks to the wish list tree
+/// (WishListDistance, Eviction::octreemizer), the named variant the camera distance
+/// (brick_camera_distance, Eviction::octreemizer_camera). Defaults are the paper's ka = 1,
+/// kl = 16, kd = 1.
 struct OctreemizerWeights {
   double ka = 1.0;
   double kl = 16.0;
@@ -101,8 +108,9 @@ double brick_camera_distance(const BrickHierarchy& h, BrickKey key, const glm::d
 /// slots, so q = kl * depth + kd * distance - ka * last_use orders like p). Touch, insert, remove
 /// and distance updates O(log n); victim O(log n) amortized: pinned slots found at the top are
 /// parked for the rest of the frame and return to the heap at the next begin_frame().
-/// Distances come from `distance` (called on insert and on every touch, so a brick keeps the
-/// distance at which it was last used) or from set_distance().
+/// Distances come from `distance` (called on insert and on every touch, and for every resident
+/// slot before the first victim after distances_changed(), which rebuilds the heap in O(n)) or
+/// from set_distance().
 class OctreemizerPolicy final : public EvictionPolicy {
  public:
   using DistanceFn = std::function<double(BrickKey)>;
@@ -118,6 +126,7 @@ class OctreemizerPolicy final : public EvictionPolicy {
   void on_remove(std::uint32_t slot) override;
   std::optional<std::uint32_t> victim(const PinState& pins) override;
   std::string_view name() const noexcept override { return "octreemizer"; }
+  void distances_changed() override { stale_ = true; }
 
   /// Sets a resident slot's distance (ignored for free slots).
   void set_distance(std::uint32_t slot, double distance);
@@ -141,6 +150,7 @@ class OctreemizerPolicy final : public EvictionPolicy {
   void sift_up(std::size_t i);
   void sift_down(std::size_t i);
   void place(std::size_t i, const HeapItem& item);
+  void refresh_distances();
 
   static constexpr std::uint32_t kAbsent = 0xFFFFFFFFu;
   static constexpr std::uint32_t kParked = 0xFFFFFFFEu;
@@ -151,6 +161,7 @@ class OctreemizerPolicy final : public EvictionPolicy {
   std::vector<std::uint32_t> pos_;  // heap position, kAbsent (free) or kParked
   std::vector<HeapItem> heap_;
   std::vector<std::uint32_t> parked_;
+  bool stale_ = false;  // distances_changed() since the last refresh
 };
 
 }  // namespace resoct

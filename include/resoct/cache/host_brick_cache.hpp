@@ -67,6 +67,8 @@ class HostBrickCache {
 
   /// The frame that later uses and insertions are recorded with (the renderer's frame).
   void set_frame(std::uint64_t frame);
+  /// Tells the policy that its distances changed (EvictionPolicy::distances_changed).
+  void distances_changed();
 
   /// The brick of `timepoint`, recorded as used; nullptr when absent (counted as hit or miss).
   std::shared_ptr<const HostBrick> get(BrickKey key, std::uint32_t timepoint = 0);

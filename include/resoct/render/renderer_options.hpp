@@ -65,7 +65,7 @@ struct ViewerOptions {
   RenderMode mode = RenderMode::residency;
   RequestStrategy strategy = RequestStrategy::greedy;
   Eviction eviction = Eviction::lru;  ///< device cache
-  /// Host cache; Eviction::octreemizer ranks by distance from the current camera.
+  /// Host cache (the Octreemizer's own cache level: main memory).
   Eviction host_eviction = Eviction::lru;
   PrefetchOptions prefetch;
   /// Bricks whose load failed with an error that may pass (a network or server fault, exhausted

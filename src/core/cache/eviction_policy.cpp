@@ -94,6 +94,7 @@ void OctreemizerPolicy::reset(std::uint32_t slot_count) {
   heap_.clear();
   heap_.reserve(slot_count);
   parked_.clear();
+  stale_ = false;
 }
 
 double OctreemizerPolicy::rank(std::uint32_t s) const {
@@ -207,7 +208,20 @@ void OctreemizerPolicy::set_distance(std::uint32_t slot, double distance) {
   heap_fix(slot);
 }
 
+void OctreemizerPolicy::refresh_distances() {
+  stale_ = false;
+  if (!distance_fn_) return;
+  for (std::uint32_t s = 0; s < pos_.size(); ++s) {
+    if (pos_[s] != kAbsent) entries_[s].distance = distance_fn_(entries_[s].key);
+  }
+  // Every rank may have changed: re-rank in place and heapify bottom-up (O(n)); parked slots are
+  // ranked when they return at the next begin_frame().
+  for (HeapItem& item : heap_) item.rank = rank(item.slot);
+  for (std::size_t i = heap_.size() / 2; i-- > 0;) sift_down(i);
+}
+
 std::optional<std::uint32_t> OctreemizerPolicy::victim(const PinState& pins) {
+  if (stale_) refresh_distances();
   while (!heap_.empty()) {
     const std::uint32_t s = heap_.front().slot;
     if (!pins.pinned(s)) return s;

@@ -19,6 +19,11 @@ HostBrickCache::HostBrickCache(std::uint64_t capacity_bytes, std::unique_ptr<Evi
 
 HostBrickCache::~HostBrickCache() = default;
 
+void HostBrickCache::distances_changed() {
+  std::lock_guard lock(mutex_);
+  policy_->distances_changed();
+}
+
 std::string_view HostBrickCache::policy_name() const noexcept {
   return policy_->name();
 }

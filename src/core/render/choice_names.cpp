@@ -26,7 +26,8 @@ constexpr Choice<RenderMode> kModes[] = {{"residency", RenderMode::residency},
 constexpr Choice<RequestStrategy> kStrategies[] = {{"greedy", RequestStrategy::greedy},
                                                    {"global", RequestStrategy::global}};
 constexpr Choice<Eviction> kEvictions[] = {{"lru", Eviction::lru},
-                                           {"octreemizer", Eviction::octreemizer}};
+                                           {"octreemizer", Eviction::octreemizer},
+                                           {"octreemizer-camera", Eviction::octreemizer_camera}};
 constexpr Choice<FrameOutput> kOutputs[] = {{"rgba32f", FrameOutput::rgba32f},
                                             {"rgba8", FrameOutput::rgba8},
                                             {"both", FrameOutput::both},

@@ -300,6 +300,7 @@ bool Renderer::Impl::handle_requests(const FrameResult& result, std::uint64_t ep
       continue;
     }
     outstanding = true;
+    if (uses_wish_list()) wish_keys_.push_back(key);
     const PageAddress target = *channels_.address_of(key);
     const auto chain = bricks_to_request(hierarchy_, target, options_.strategy, available);
     for (std::size_t j = 0; j < chain.size(); ++j) {
@@ -332,6 +333,24 @@ bool Renderer::Impl::handle_requests(const FrameResult& result, std::uint64_t ep
   pending_nodes_.clear();
   for (const Request& r : result.node_requests) pending_nodes_.push_back(r.key);
   return outstanding || !pending_nodes_.empty() || result.stats.requests_dropped != 0;
+}
+
+bool Renderer::Impl::uses_wish_list() const noexcept {
+  return options_.eviction == Eviction::octreemizer ||
+         options_.host_eviction == Eviction::octreemizer;
+}
+
+void Renderer::Impl::publish_wish_list() {
+  auto tree = std::make_shared<WishListDistance>(hierarchy_);
+  tree->assign(wish_keys_);
+  {
+    std::lock_guard lock(wish_list_->mutex);
+    wish_list_->tree = std::move(tree);
+  }
+  // Every resident brick's d may have changed: the policies re-read them before their next
+  // victim (not now, so a frame that evicts nothing pays nothing).
+  cache_->policy().distances_changed();
+  loader_->host_cache().distances_changed();
 }
 
 void Renderer::Impl::prefetch_next_timepoint(const Scene& scene, std::size_t max,
@@ -520,7 +539,12 @@ void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report,
   }
   stats.working_set_bricks = used.size();
   stats.working_set_bytes = used.size() * cache_->slot_bytes();
+  wish_keys_.clear();
+  if (uses_wish_list()) {
+    for (std::uint32_t s : used) wish_keys_.push_back(*cache_->key_of(s));
+  }
   const bool outstanding = handle_requests(result_, epoch, stats);
+  if (uses_wish_list()) publish_wish_list();
   prefetch(scene, stats);
   stats.ms_requests = ms_since(t);
   report_failures(report);

@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "resoct/cache/wish_list_distance.hpp"
 #include "resoct/engine/brick_cache.hpp"
 #include "resoct/engine/brick_loader.hpp"
 #include "resoct/engine/channel_map.hpp"
@@ -30,6 +31,21 @@ namespace detail {
 struct SharedEye {
   std::mutex mutex;
   glm::dvec3 eye{0.0};
+};
+
+/// The last frame's wish list tree, read by the caches' published Octreemizer policies (the host
+/// cache's on loader threads): each frame publishes a new immutable tree.
+struct SharedWishList {
+  std::mutex mutex;
+  std::shared_ptr<const WishListDistance> tree;  // null before the first frame: every d is 0
+  double distance(BrickKey key) {
+    std::shared_ptr<const WishListDistance> t;
+    {
+      std::lock_guard lock(mutex);
+      t = tree;
+    }
+    return t ? double(t->distance(key)) : 0.0;
+  }
 };
 
 /// Whether a page-table entry is UNMAPPED (neither a cache slot nor EMPTY / HOMOGENEOUS).
@@ -59,6 +75,10 @@ struct Renderer::Impl {
   void evict(BrickKey key);
   void send_update(FrameStats& stats);
   void answer_nodes(FrameStats& stats);
+  // The published Octreemizer priority is in use (device or host cache): wish_keys_ is collected
+  // and published as the wish list tree after each frame.
+  bool uses_wish_list() const noexcept;
+  void publish_wish_list();
   bool handle_requests(const FrameResult& result, std::uint64_t epoch, FrameStats& stats);
   void prefetch(const Scene& scene, FrameStats& stats);
   void report_failures(FrameReport& report);
@@ -83,6 +103,10 @@ struct Renderer::Impl {
   glm::dvec3 camera_{0.0};                   // eye in physical units (Octreemizer distances)
   // The same for the host cache's policy, which runs on loader threads.
   std::shared_ptr<detail::SharedEye> host_camera_ = std::make_shared<detail::SharedEye>();
+  // The wish list tree of the published Octreemizer priority (Eviction::octreemizer), and this
+  // frame's wish list while it is collected (sampled bricks, then requested ones).
+  std::shared_ptr<detail::SharedWishList> wish_list_ = std::make_shared<detail::SharedWishList>();
+  std::vector<BrickKey> wish_keys_;
   CameraPredictor predictor_;
   std::uint64_t frame_ = 0;
   // loader_threads = 0: bricks the frame's requests loaded synchronously (of the brick budget).

@@ -14,6 +14,7 @@ namespace {
 
 using detail::page_unmapped;
 using detail::SharedEye;
+using detail::SharedWishList;
 
 const BrickSource& checked_source(const std::shared_ptr<const BrickSource>& s) {
   if (!s) throw invalid_parameter("source", "must not be null");
@@ -52,10 +53,18 @@ std::uint32_t pool_blocks_for(const RendererOptions& o, const BrickHierarchy& h,
   return std::uint32_t(blocks);
 }
 
-// Options are validated before the policies are made, so `policy` is one of the two.
+// Options are validated before the policies are made, so `policy` is one of the three. The
+// published Octreemizer distance is the neighbourhood distance in bricks to the last frame's wish
+// list tree; the camera variant measures from the eye in physical units.
 std::unique_ptr<EvictionPolicy> make_policy(Eviction policy, const BrickHierarchy& h,
-                                            const glm::dvec3* camera) {
+                                            const glm::dvec3* camera,
+                                            std::shared_ptr<SharedWishList> wish) {
   if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
+  if (policy == Eviction::octreemizer) {
+    return std::make_unique<OctreemizerPolicy>(
+        h.level_count(), OctreemizerWeights{},
+        [wish = std::move(wish)](BrickKey key) { return wish->distance(key); });
+  }
   // Distances in physical units from the camera of the frame being rendered.
   return std::make_unique<OctreemizerPolicy>(
       h.level_count(), OctreemizerWeights{},
@@ -63,8 +72,9 @@ std::unique_ptr<EvictionPolicy> make_policy(Eviction policy, const BrickHierarch
 }
 
 std::unique_ptr<EvictionPolicy> make_host_policy(Eviction policy, const BrickHierarchy& h,
-                                                 std::shared_ptr<SharedEye> eye) {
-  if (policy == Eviction::lru) return std::make_unique<LruPolicy>();
+                                                 std::shared_ptr<SharedEye> eye,
+                                                 std::shared_ptr<SharedWishList> wish) {
+  if (policy != Eviction::octreemizer_camera) return make_policy(policy, h, nullptr, wish);
   return std::make_unique<OctreemizerPolicy>(h.level_count(), OctreemizerWeights{},
                                              [&h, eye](BrickKey key) {
                                                glm::dvec3 e;
@@ -106,9 +116,9 @@ Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<
       pages_(hierarchy_, slot_count_for(options_, *source_),
              pool_blocks_for(options_, hierarchy_, slot_count_for(options_, *source_))),
       channels_(pages_.slot_count(), hierarchy_.volume().channels) {
-  cache_ = std::make_unique<BrickCache>(hierarchy_.layout(), hierarchy_.volume().type,
-                                        options_.device_cache_bytes, options_.ttl,
-                                        make_policy(options_.eviction, hierarchy_, &camera_));
+  cache_ = std::make_unique<BrickCache>(
+      hierarchy_.layout(), hierarchy_.volume().type, options_.device_cache_bytes, options_.ttl,
+      make_policy(options_.eviction, hierarchy_, &camera_, wish_list_));
   // Residency means "sampling needs no cache miss": EMPTY and HOMOGENEOUS entries qualify as
   // well as MAPPED ones, so the traversal may use such a level without touching the cache.
   octree_ = std::make_unique<ResidencyOctree>(
@@ -118,7 +128,7 @@ Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<
       });
   loader_ = std::make_unique<BrickLoader>(
       source_, options_.loader_threads, options_.host_cache_bytes,
-      make_host_policy(options_.host_eviction, hierarchy_, host_camera_),
+      make_host_policy(options_.host_eviction, hierarchy_, host_camera_, wish_list_),
       std::make_shared<const OctreeLayout>(layout_));
   loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
   timepoint_ = source_->timepoint();

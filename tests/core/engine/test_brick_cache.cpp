@@ -60,7 +60,9 @@ struct Model {
   }
 };
 
-enum class Kind { lru, octreemizer };
+// octreemizer_refresh: every frame moves the camera and calls distances_changed(), so every
+// resident slot's distance is the new camera's (the published Octreemizer's per-frame wish list).
+enum class Kind { lru, octreemizer, octreemizer_refresh };
 
 // Runs random frames of touches, inserts and releases and checks every eviction decision.
 void run_random(Kind kind, std::uint32_t ttl, std::uint32_t slots, std::uint32_t seed) {
@@ -69,7 +71,7 @@ void run_random(Kind kind, std::uint32_t ttl, std::uint32_t slots, std::uint32_t
   double camera = 0.0;
   const OctreemizerWeights w{1.0, 16.0, 0.5};
   std::unique_ptr<EvictionPolicy> policy;
-  if (kind == Kind::octreemizer) {
+  if (kind != Kind::lru) {
     policy = std::make_unique<OctreemizerPolicy>(
         kLevels, w, [&](BrickKey k) { return std::abs(double(k.brick().x % 40) - camera); });
   }
@@ -84,6 +86,12 @@ void run_random(Kind kind, std::uint32_t ttl, std::uint32_t slots, std::uint32_t
     cache.begin_frame(frame);
     m.frame = frame;
     camera = double(rnd(40));
+    if (kind == Kind::octreemizer_refresh) {
+      cache.policy().distances_changed();
+      for (auto& [slot, s] : m.resident) {
+        s.distance = std::abs(double(s.key.brick().x % 40) - camera);
+      }
+    }
     const std::uint32_t ops = 1 + rnd(3 * slots);
     for (std::uint32_t op = 0; op < ops; ++op) {
       const std::uint32_t what = rnd(10);
@@ -189,6 +197,15 @@ TEST(BrickCache, LruNeverEvictsPinnedForAnyTtl) {
 TEST(BrickCache, OctreemizerEvictsTheHighestDiscardPriority) {
   for (std::uint32_t seed = 1; seed <= 6; ++seed) run_random(Kind::octreemizer, 2, 12, seed);
   for (std::uint32_t ttl : {0u, 1u, 4u}) run_random(Kind::octreemizer, ttl, 7, 50 + ttl);
+}
+
+// distances_changed() re-reads every resident slot's distance (parked ones included) before the
+// next victim, so the victim is the highest priority under the new distances.
+TEST(BrickCache, OctreemizerRereadsDistancesAfterTheyChange) {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    run_random(Kind::octreemizer_refresh, 2, 12, seed);
+  }
+  for (std::uint32_t ttl : {0u, 1u, 4u}) run_random(Kind::octreemizer_refresh, ttl, 7, 70 + ttl);
 }
 
 TEST(BrickCache, TtlProtectsFreshUploads) {

@@ -14,7 +14,7 @@ TEST(RendererOptions, ChoiceNamesRoundTrip) {
   for (const auto s : {RequestStrategy::greedy, RequestStrategy::global}) {
     EXPECT_EQ(parse_request_strategy(to_string(s)), s);
   }
-  for (const auto e : {Eviction::lru, Eviction::octreemizer}) {
+  for (const auto e : {Eviction::lru, Eviction::octreemizer, Eviction::octreemizer_camera}) {
     EXPECT_EQ(parse_eviction(to_string(e)), e);
   }
   for (const auto o :
@@ -25,6 +25,7 @@ TEST(RendererOptions, ChoiceNamesRoundTrip) {
     EXPECT_EQ(parse_render_mode(to_string(m)), m);
   }
   EXPECT_STREQ(to_string(RequestStrategy::global), "global");
+  EXPECT_STREQ(to_string(Eviction::octreemizer_camera), "octreemizer-camera");
   EXPECT_STREQ(to_string(static_cast<Eviction>(9)), "unknown");
 }
 
@@ -34,7 +35,8 @@ TEST(RendererOptions, UnknownNamesNameTheParameterAndTheChoices) {
   EXPECT_RESOCT_ERROR(parse_request_strategy("lazy", "--strategy"), ErrorCode::invalid_argument,
                       "parameter '--strategy'");
   EXPECT_RESOCT_ERROR(parse_eviction("fifo"), ErrorCode::invalid_argument,
-                      "parameter 'eviction': 'fifo' is not one of lru, octreemizer");
+                      "parameter 'eviction': 'fifo' is not one of lru, octreemizer, "
+                      "octreemizer-camera");
   EXPECT_RESOCT_ERROR(parse_frame_output("rgb"), ErrorCode::invalid_argument,
                       "parameter 'output': 'rgb' is not one of rgba32f, rgba8, both");
   EXPECT_RESOCT_ERROR(parse_render_mode("ray"), ErrorCode::invalid_argument,

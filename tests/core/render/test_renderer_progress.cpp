@@ -61,6 +61,9 @@ TEST(RendererProgress, SmallCacheProgressesEveryTtlFramesWithTtl2) {
 TEST(RendererProgress, SmallCacheWithOctreemizerEviction) {
   run_small_cache(2, "octreemizer");
 }
+TEST(RendererProgress, SmallCacheWithOctreemizerCameraEviction) {
+  run_small_cache(2, "octreemizer-camera");
+}
 
 TEST(RendererProgress, ConvergeTerminatesAtTheCap) {
   auto src = make_test_source();
