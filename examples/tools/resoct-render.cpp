@@ -4,6 +4,8 @@
 //   resoct-render --volume procedural:tubes --scene examples/scenes/tubes.json
 //                 --out tubes.png --stats tubes.json --converge   (one command line)
 #include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -19,6 +21,8 @@
 #include "resoct/io/open_source.hpp"
 #include "resoct/io/overview_hints.hpp"
 #include "resoct/render/frame_accumulator.hpp"
+#include "resoct/render/reference_renderer.hpp"
+#include "resoct/render/reference_voxels.hpp"
 #include "resoct/render/renderer.hpp"
 #include "resoct/render/renderer_inspection.hpp"
 #include "resoct/scene/overview_scene.hpp"
@@ -63,6 +67,10 @@ struct Args {
   std::optional<std::uint32_t> timepoint;  // overrides the scene's
   std::string play;                        // "FIRST:LAST": one image per timepoint
   bool no_play_prefetch = false;
+  // --report-accuracy: the dense reference of the same view (docs/tools.md).
+  bool report_accuracy = false;
+  double reference_step = 0.125;      // in reference steps (one level-0 voxel)
+  std::uint64_t reference_mb = 4096;  // level 0 of the shown channels, as floats
 };
 
 /// The --out path of timepoint t while playing: "{t}" replaced by the timepoint.
@@ -102,9 +110,70 @@ struct Totals {
   }
 };
 
+/// --report-accuracy: the scene rendered by the dense reference renderer (level 0, double
+/// precision, steps of `reference_step` voxels, reference_renderer.hpp) from the source's level 0,
+/// and the image's error against it, beside the frame time. Returns the "accuracy" stats object.
+nlohmann::json report_accuracy(const Args& a, const Renderer& renderer, const Scene& scene,
+                               const Image& image, double steady_ms) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  std::shared_ptr<const BrickSource> timepoint_source;
+  const BrickSource* source = &renderer.source();
+  if (renderer.timepoints() > 1) {
+    timepoint_source = renderer.source().open_timepoint(renderer.timepoint());
+    source = timepoint_source.get();
+  }
+  std::vector<std::uint32_t> channels;
+  for (const ChannelSettings& c : scene.channels) {
+    if (std::find(channels.begin(), channels.end(), c.channel) == channels.end()) {
+      channels.push_back(c.channel);
+    }
+  }
+  std::uint32_t last_percent = 0;
+  const reference::VoxelFunction voxels = reference::level0_voxels(
+      *source, channels, a.reference_mb << 20, "reference-mb",
+      [&](std::uint64_t done, std::uint64_t total) {
+        const auto percent = std::uint32_t(100 * done / total);
+        if (percent / 25 != last_percent / 25 || done == total) {
+          std::fprintf(stderr, "resoct-render: reading level 0 for the reference: %u%%\n", percent);
+        }
+        last_percent = percent;
+      });
+  const auto t1 = Clock::now();
+  std::fprintf(stderr, "resoct-render: rendering the dense reference (%ux%u, step %g voxel)\n",
+               scene.viewport.width, scene.viewport.height, a.reference_step);
+  reference::ReferenceOptions ro;
+  ro.step = a.reference_step;
+  ro.threads = 0;
+  const Image ref = reference::render_reference(scene, source->volume(), voxels, ro);
+  const auto t2 = Clock::now();
+  const ImageDiff d = compare_images(image, ref);
+  const double max_rgb = std::max({d.max_abs.r, d.max_abs.g, d.max_abs.b});
+  const double s_read = std::chrono::duration<double>(t1 - t0).count();
+  const double s_render = std::chrono::duration<double>(t2 - t1).count();
+  std::fprintf(stderr,
+               "resoct-render: accuracy against the dense reference: RMSE %.3f/255, PSNR %.2f "
+               "dB, max %.1f/255 (RGB) at %.2f ms/frame steady (reference: %.1f s reading, "
+               "%.1f s rendering)\n",
+               255.0 * d.rmse_rgb, d.psnr_rgb, 255.0 * max_rgb, steady_ms, s_read, s_render);
+  nlohmann::json j;
+  j["rmse_rgb"] = d.rmse_rgb;
+  // JSON has no infinity: an identical image reports a PSNR of null.
+  j["psnr_rgb_db"] = std::isfinite(d.psnr_rgb) ? nlohmann::json(d.psnr_rgb) : nlohmann::json();
+  j["max_abs_rgb"] = max_rgb;
+  j["max_abs_alpha"] = d.max_abs.a;
+  j["reference_step"] = a.reference_step;
+  j["reference_level"] = 0;
+  j["ms_per_frame_steady"] = steady_ms;
+  j["s_reference_read"] = s_read;
+  j["s_reference_render"] = s_render;
+  return j;
+}
+
 void write_stats(const std::string& path, const Args& a, const FrameReport& last,
                  std::uint32_t frames, bool converged, double steady_ms, std::uint32_t steady_count,
-                 const Totals& t, const Renderer& r, const std::vector<PlayedTimepoint>& played) {
+                 const Totals& t, const Renderer& r, const std::vector<PlayedTimepoint>& played,
+                 const nlohmann::json& accuracy) {
   const FrameStats& s = last.stats;
   nlohmann::json j;
   j["volume"] = a.volume;
@@ -160,6 +229,7 @@ void write_stats(const std::string& path, const Args& a, const FrameReport& last
   for (const LoadFailure& x : t.failures) f.push_back(x.message);
   j["load_failures"] = f;
   if (t.validation_messages) j["validation_messages"] = *t.validation_messages;
+  if (!accuracy.is_null()) j["accuracy"] = accuracy;
   const std::string text = j.dump(2) + "\n";
   AtomicFileWriter w(path);
   w.append(std::as_bytes(std::span(text.data(), text.size())));
@@ -209,6 +279,12 @@ int run(const Args& a) {
   }
   if (a.frames == 0 && !a.converge)
     throw invalid_parameter("frames", "give --frames N or --converge");
+  if (!(a.reference_step > 0.0 && a.reference_step <= 1.0)) {
+    throw invalid_parameter("reference-step", "must be in (0, 1] voxel");
+  }
+  if (a.reference_mb == 0 || a.reference_mb > (std::uint64_t(1) << 24)) {
+    throw invalid_parameter("reference-mb", "must be 1..2^24");
+  }
   std::optional<std::pair<std::uint32_t, std::uint32_t>> play;
   if (!a.play.empty()) {
     play = resoct::tools::parse_index_range(a.play, "play");
@@ -252,6 +328,33 @@ int run(const Args& a) {
     scene.timepoint = *a.timepoint;
   }
   if (play) check_timepoint("play", play->second);
+  // The reference models emission-absorption, shading, isosurfaces and projections, not shadows,
+  // slice planes or a lens: refuse before rendering rather than report a meaningless error.
+  if (a.report_accuracy) {
+    const char* unmodelled = scene.has_effect(Effect::shadows) ? "shadows"
+                             : !scene.slices.empty()           ? "slice planes"
+                             : scene.lens                      ? "a lens"
+                                                               : nullptr;
+    if (unmodelled != nullptr) {
+      throw invalid_parameter("report-accuracy", std::string("the dense reference does not "
+                                                             "model the scene's ") +
+                                                     unmodelled);
+    }
+    // Level 0 of the shown channels must fit the limit: checked now, not after the render.
+    const VolumeDesc& v = renderer.hierarchy().volume();
+    std::vector<std::uint32_t> shown;
+    for (const ChannelSettings& c : scene.channels) shown.push_back(c.channel);
+    std::sort(shown.begin(), shown.end());
+    shown.erase(std::unique(shown.begin(), shown.end()), shown.end());
+    const long double need =
+        (long double)v.extent.x * v.extent.y * v.extent.z * 4.0L * (long double)shown.size();
+    if (need > (long double)(a.reference_mb << 20)) {
+      throw invalid_parameter("reference-mb",
+                              "the dense reference needs " +
+                                  std::to_string(std::uint64_t(need / 1048576.0L) + 1) +
+                                  " MiB for level 0 of the shown channels; raise --reference-mb");
+    }
+  }
   renderer.set_failure_callback([](const LoadFailure& f) {
     std::fprintf(stderr, "resoct-render: warning: %s\n", f.message.c_str());
   });
@@ -347,9 +450,15 @@ int run(const Args& a) {
     }
   }
 #endif
+  // The accuracy report comes first: if it fails, no output is left half written.
+  nlohmann::json accuracy;
+  if (a.report_accuracy) {
+    accuracy = report_accuracy(a, renderer, scene, acc ? acc->image() : last.image, steady);
+  }
   if (!a.out.empty() && !play) write_png(acc ? acc->image() : last.image, a.out);
   if (!a.stats.empty()) {
-    write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer, played);
+    write_stats(a.stats, a, last, frames, converged, steady, tail, totals, renderer, played,
+                accuracy);
   }
   std::fprintf(stderr, "resoct-render: %u frames, %s, %.2f ms/frame steady\n", frames,
                converged ? "converged" : "not converged", steady);
@@ -404,6 +513,17 @@ int main(int argc, char** argv) {
       ->excludes(timepoint);
   app.add_flag("--no-play-prefetch", a.no_play_prefetch,
                "with --play: do not prefetch the next timepoint (for comparisons)");
+  app.add_flag("--report-accuracy", a.report_accuracy,
+               "render the dense reference of the same view (level 0, double precision) and "
+               "print RMSE, PSNR and max error beside ms/frame (docs/renderer.md; not with --play)")
+      ->excludes("--play");
+  app.add_option("--reference-step", a.reference_step,
+                 "with --report-accuracy: the reference's step in level-0 voxels")
+      ->capture_default_str();
+  app.add_option("--reference-mb", a.reference_mb,
+                 "with --report-accuracy: memory for level 0 of the shown channels (4 bytes per "
+                 "voxel and channel)")
+      ->capture_default_str();
   resoct::tools::one_line_usage_errors(app, "resoct-render");
   try {
     app.parse(argc, argv);

@@ -148,6 +148,43 @@ TEST(RenderTool, EffectScenesReportGradientsAndShadowRays) {
   }
 }
 
+// --report-accuracy renders the dense reference of the same view: the stats carry the error, it
+// is small at a fine step at level 0 and grows when the renderer's step grows (so it measures the
+// renderer, not a constant), and the PNG is the renderer's image, not the reference.
+TEST(RenderTool, ReportAccuracyComparesWithTheDenseReference) {
+  TempDir dir;
+  std::map<double, double> rmse;
+  for (const double step_scale : {0.5, 4.0}) {
+    nlohmann::json sc = nlohmann::json::parse(slurp(scene("tubes")));
+    sc["step_scale"] = step_scale;
+    // Level 0 only: the reference's level, so that the error is the step's (a 48^3 volume in
+    // 40 x 32 pixels would otherwise be drawn from coarser levels at any step).
+    for (nlohmann::json& c : sc["channels"]) c["levels"] = {0, 0};
+    const std::string scene_path = dir.file("tubes_" + std::to_string(step_scale) + ".json");
+    std::ofstream(scene_path) << sc.dump();
+    const std::string png = dir.file("a.png"), stats = dir.file("a.json");
+    const ToolRun r = run(
+        dir, RESOCT_RENDER,
+        render_args("procedural:tubes:48x48x48", scene_path, png, stats) + " --report-accuracy");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("accuracy against the dense reference: RMSE"), std::string::npos) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(stats));
+    ASSERT_TRUE(j.contains("accuracy"));
+    const nlohmann::json& acc = j["accuracy"];
+    for (const char* key : {"rmse_rgb", "psnr_rgb_db", "max_abs_rgb", "reference_step",
+                            "ms_per_frame_steady", "s_reference_render"}) {
+      EXPECT_TRUE(acc.contains(key)) << key;
+    }
+    EXPECT_EQ(acc["reference_step"].get<double>(), 0.125);
+    EXPECT_GE(acc["max_abs_rgb"].get<double>(), acc["rmse_rgb"].get<double>());
+    rmse[step_scale] = acc["rmse_rgb"].get<double>();
+    EXPECT_EQ(resoct::read_png(png).width(), 40u);
+  }
+  EXPECT_GT(rmse[0.5], 0.0);
+  EXPECT_LT(rmse[0.5], 2.0 / 255.0);
+  EXPECT_GT(rmse[4.0], 2.0 * rmse[0.5]);
+}
+
 TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
   TempDir dir;
   const std::string png = dir.file("x.png"), stats = dir.file("x.json");
@@ -165,6 +202,15 @@ TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
       {render_args(ok_volume, scene("tubes"), dir.file("no/dir/x.png"), stats), "no/dir"},
       // The cells scene shows channels 0-3; a one-channel volume has only channel 0.
       {render_args(ok_volume, scene("cells"), png, stats), "channel"},
+      // --report-accuracy: a scene the reference does not model, a level 0 beyond the memory
+      // limit (32^3 u8 = 128 KiB as floats, limit 1 MiB: 128^3 needs 8 MiB), a bad step.
+      {render_args(ok_volume, scene("sphere_iso"), png, stats) + " --report-accuracy",
+       "report-accuracy"},
+      {render_args("procedural:tubes:128x128x128", scene("tubes"), png, stats) +
+           " --report-accuracy --reference-mb 1",
+       "reference-mb"},
+      {render_args(ok_volume, scene("tubes"), png, stats) + " --report-accuracy --reference-step 0",
+       "reference-step"},
   };
   for (const Case& c : cases) {
     const ToolRun r = run(dir, RESOCT_RENDER, c.args);

@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <memory>
 #include <random>
 #include <set>
 #include <vector>
 
+#include "resoct/cache/eviction_policy.hpp"
 #include "resoct/cache/wish_list_distance.hpp"
+#include "resoct/engine/brick_cache.hpp"
 #include "support/expect_error.hpp"
 
 using namespace resoct;
@@ -142,4 +145,32 @@ TEST(WishListDistance, KeysOutsideTheHierarchyAreRejectedAndTheListKept) {
                       ErrorCode::out_of_range, "level 9");
   EXPECT_EQ(d.distance(BrickKey(0, 0, {1, 1, 1})), 0u);
   EXPECT_EQ(d.distance(BrickKey(0, 0, {3, 1, 0})), 2u);
+}
+
+// The published Octreemizer priority end to end: with equal age and level, the brick farthest
+// from the wish list tree goes first, and a new wish list (distances_changed) reorders at once.
+TEST(WishListDistance, OctreemizerEvictsTheBrickFarthestFromTheWishList) {
+  const BrickHierarchy h = hierarchy(glm::u64vec3(256), 1, 32);  // 8^3 bricks at level 0
+  auto wish = std::make_shared<WishListDistance>(h);
+  auto policy = std::make_unique<OctreemizerPolicy>(
+      h.level_count(), OctreemizerWeights{},
+      [&wish](BrickKey k) { return double(wish->distance(k)); });
+  BrickCache cache(h.layout(), VoxelType::u8, h.layout().padded_voxels() * 3, 0, std::move(policy));
+  cache.begin_frame(1);
+  for (const std::uint32_t x : {0u, 3u, 7u}) ASSERT_TRUE(cache.insert(BrickKey(0, 0, {x, 0, 0})));
+  // Wished: x = 0. Distances 0, 3, 7: the brick at x = 7 is evicted first.
+  cache.begin_frame(2);
+  wish->assign(std::vector<BrickKey>{BrickKey(0, 0, {0, 0, 0})});
+  cache.policy().distances_changed();
+  auto ins = cache.insert(BrickKey(0, 0, {1, 1, 1}));
+  ASSERT_TRUE(ins && ins->evicted);
+  EXPECT_EQ(*ins->evicted, BrickKey(0, 0, {7, 0, 0}));
+  // The wish list moves to x = 7. p = age + d: x = 0 has 2 + 7, x = 3 has 2 + 4, and {1, 1, 1},
+  // inserted a frame later, 1 + 6: x = 0 goes.
+  cache.begin_frame(3);
+  wish->assign(std::vector<BrickKey>{BrickKey(0, 0, {7, 0, 0})});
+  cache.policy().distances_changed();
+  ins = cache.insert(BrickKey(0, 0, {6, 0, 0}));
+  ASSERT_TRUE(ins && ins->evicted);
+  EXPECT_EQ(*ins->evicted, BrickKey(0, 0, {0, 0, 0}));
 }

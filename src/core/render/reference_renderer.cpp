@@ -1,7 +1,9 @@
-#include "support/reference_renderer.hpp"
+#include "resoct/render/reference_renderer.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <thread>
 #include <limits>
 #include <vector>
 
@@ -10,7 +12,7 @@
 
 #include "resoct/base/error.hpp"
 
-namespace resoct::test {
+namespace resoct::reference {
 
 VoxelFunction dense_voxels(const glm::u64vec3& extent, std::vector<std::vector<double>> channels) {
   const std::uint64_t count = extent.x * extent.y * extent.z;
@@ -256,14 +258,40 @@ Image render_reference(const Scene& scene, const VolumeDesc& volume, const Voxel
   const CameraRays rays(scene.camera, scene.viewport);
   Image image(scene.viewport.width, scene.viewport.height);
   const glm::dvec4 bg = scene.background;
-  for (std::uint32_t y = 0; y < scene.viewport.height; ++y) {
-    for (std::uint32_t x = 0; x < scene.viewport.width; ++x) {
-      const glm::dvec4 acc = reference_ray(scene, volume, voxels, rays.pixel_ray(x, y), options);
-      const glm::dvec4 out = acc + (1.0 - acc.a) * glm::dvec4(glm::dvec3(bg) * bg.a, bg.a);
-      image.at(x, y) = out.a > 0.0 ? glm::vec4(glm::dvec3(out) / out.a, out.a) : glm::vec4(0.0f);
+  const auto rows = [&](std::uint32_t first, std::uint32_t stride) {
+    for (std::uint32_t y = first; y < scene.viewport.height; y += stride) {
+      for (std::uint32_t x = 0; x < scene.viewport.width; ++x) {
+        const glm::dvec4 acc = reference_ray(scene, volume, voxels, rays.pixel_ray(x, y), options);
+        const glm::dvec4 out = acc + (1.0 - acc.a) * glm::dvec4(glm::dvec3(bg) * bg.a, bg.a);
+        image.at(x, y) = out.a > 0.0 ? glm::vec4(glm::dvec3(out) / out.a, out.a) : glm::vec4(0.0f);
+      }
     }
+  };
+  const std::uint32_t threads = std::min(
+      options.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : options.threads,
+      scene.viewport.height);
+  if (threads <= 1) {
+    rows(0, 1);
+    return image;
+  }
+  // Rows interleaved over the threads; the first error any of them meets is rethrown.
+  std::vector<std::exception_ptr> errors(threads);
+  {
+    std::vector<std::jthread> pool;
+    for (std::uint32_t t = 0; t < threads; ++t) {
+      pool.emplace_back([&, t] {
+        try {
+          rows(t, threads);
+        } catch (...) {
+          errors[t] = std::current_exception();
+        }
+      });
+    }
+  }
+  for (const std::exception_ptr& e : errors) {
+    if (e) std::rethrow_exception(e);
   }
   return image;
 }
 
-}  // namespace resoct::test
+}  // namespace resoct::reference
