@@ -110,6 +110,15 @@ struct Totals {
   }
 };
 
+/// The dataset channels a scene shows, each once, ascending.
+std::vector<std::uint32_t> shown_channels(const Scene& scene) {
+  std::vector<std::uint32_t> shown;
+  for (const ChannelSettings& c : scene.channels) shown.push_back(c.channel);
+  std::sort(shown.begin(), shown.end());
+  shown.erase(std::unique(shown.begin(), shown.end()), shown.end());
+  return shown;
+}
+
 /// --report-accuracy: the scene rendered by the dense reference renderer (level 0, double
 /// precision, steps of `reference_step` voxels, reference_renderer.hpp) from the source's level 0,
 /// and the image's error against it, beside the frame time. Returns the "accuracy" stats object.
@@ -123,12 +132,7 @@ nlohmann::json report_accuracy(const Args& a, const Renderer& renderer, const Sc
     timepoint_source = renderer.source().open_timepoint(renderer.timepoint());
     source = timepoint_source.get();
   }
-  std::vector<std::uint32_t> channels;
-  for (const ChannelSettings& c : scene.channels) {
-    if (std::find(channels.begin(), channels.end(), c.channel) == channels.end()) {
-      channels.push_back(c.channel);
-    }
-  }
+  const std::vector<std::uint32_t> channels = shown_channels(scene);
   std::uint32_t last_percent = 0;
   const reference::VoxelFunction voxels = reference::level0_voxels(
       *source, channels, a.reference_mb << 20, "reference-mb",
@@ -342,12 +346,8 @@ int run(const Args& a) {
     }
     // Level 0 of the shown channels must fit the limit: checked now, not after the render.
     const VolumeDesc& v = renderer.hierarchy().volume();
-    std::vector<std::uint32_t> shown;
-    for (const ChannelSettings& c : scene.channels) shown.push_back(c.channel);
-    std::sort(shown.begin(), shown.end());
-    shown.erase(std::unique(shown.begin(), shown.end()), shown.end());
-    const long double need =
-        (long double)v.extent.x * v.extent.y * v.extent.z * 4.0L * (long double)shown.size();
+    const long double need = (long double)v.extent.x * v.extent.y * v.extent.z * 4.0L *
+                             (long double)shown_channels(scene).size();
     if (need > (long double)(a.reference_mb << 20)) {
       throw invalid_parameter("reference-mb",
                               "the dense reference needs " +

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -62,6 +63,23 @@ struct DataMapping {
 
 /// u8, u16, f32: themselves; i8 -> u8 + 128; i16 -> u16 + 32768; i32, u32, f64 -> f32.
 DataMapping data_mapping(DataType t) noexcept;
+/// The raw value of one stored voxel of type `t` at `p` (unaligned; host byte order).
+inline double voxel_value(const std::byte* p, VoxelType t) noexcept {
+  switch (t) {
+    case VoxelType::u8: return double(std::uint8_t(*p));
+    case VoxelType::u16: {
+      std::uint16_t v;
+      std::memcpy(&v, p, sizeof v);
+      return double(v);
+    }
+    case VoxelType::f32: {
+      float v;
+      std::memcpy(&v, p, sizeof v);
+      return double(v);
+    }
+  }
+  return 0.0;
+}
 /// The DataType whose values a VoxelType holds unmapped.
 constexpr DataType data_type_of(VoxelType t) noexcept {
   return DataType(std::uint8_t(t));

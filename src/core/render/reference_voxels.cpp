@@ -1,6 +1,5 @@
 #include "resoct/render/reference_voxels.hpp"
 
-#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -8,26 +7,6 @@
 #include "resoct/base/error.hpp"
 
 namespace resoct::reference {
-
-namespace {
-
-double raw_value(VoxelType type, const std::byte* p) {
-  switch (type) {
-    case VoxelType::u8: return double(std::uint8_t(*p));
-    case VoxelType::u16: {
-      std::uint16_t v;
-      std::memcpy(&v, p, sizeof v);
-      return double(v);
-    }
-    default: {
-      float v;
-      std::memcpy(&v, p, sizeof v);
-      return double(v);
-    }
-  }
-}
-
-}  // namespace
 
 VoxelFunction level0_voxels(const BrickSource& source, std::span<const std::uint32_t> channels,
                             std::uint64_t max_bytes, const std::string& parameter,
@@ -77,7 +56,7 @@ VoxelFunction level0_voxels(const BrickSource& source, std::span<const std::uint
                                         std::size_t(i - core.lo.x) + halo;
                 const std::size_t dst =
                     (std::size_t(k) * v.extent.y + std::size_t(j)) * v.extent.x + std::size_t(i);
-                out[dst] = float(raw_value(v.type, brick.data() + src * vsize));
+                out[dst] = float(voxel_value(brick.data() + src * vsize, v.type));
               }
             }
           }

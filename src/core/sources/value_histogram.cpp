@@ -8,27 +8,6 @@
 
 namespace resoct {
 
-namespace {
-
-double voxel_value(const std::byte* p, VoxelType t) {
-  switch (t) {
-    case VoxelType::u8: return double(std::uint8_t(*p));
-    case VoxelType::u16: {
-      std::uint16_t v;
-      std::memcpy(&v, p, sizeof v);
-      return double(v);
-    }
-    case VoxelType::f32: {
-      float v;
-      std::memcpy(&v, p, sizeof v);
-      return double(v);
-    }
-  }
-  return 0.0;
-}
-
-}  // namespace
-
 std::vector<std::uint64_t> coarse_value_histogram(const BrickSource& source, std::uint32_t channel,
                                                   std::uint32_t bins) {
   const BrickHierarchy& h = source.hierarchy();
