@@ -206,5 +206,47 @@ TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
   }
 }
 
+// Where a channel samples a coarse level, a node's class holds only inside the node shrunk by
+// half a voxel of that level (the trilinear support reaches that far beyond it); in the rim that
+// is left, every channel is looked up. An all-zero brick there is an EMPTY page, which settles
+// the channel as in the page-table mode: the residency march skips it (it used to step through
+// its samples, which add nothing). Values are 0 or 255, the transfer function hides [0, 0.1] and
+// the leaves are the sampled level's bricks, so no node is empty where its brick is not: the
+// residency mode skips exactly the page table's distance and renders its image.
+TEST(ExactCulling, EmptyBricksInTheRimOfEmptyNodesAreSkipped) {
+  VolumeDesc v;
+  v.extent = {64, 64, 64};
+  v.type = VoxelType::u8;
+  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
+    const glm::dvec3 d = glm::dvec3(p) + 0.5 - glm::dvec3(32.0, 28.0, 34.0);
+    return glm::dot(d, d) < 21.0 * 21.0 ? 255.0 : 0.0;
+  });
+  for (std::uint32_t level : {0u, 1u}) {
+    ResidentOptions ro;
+    ro.leaf_size = glm::uvec3(8u << level);
+    ResidentScene rs(src, {0}, ro);
+    Scene s = make_scene(40, oblique_camera());
+    s.channels = {make_channel(0,
+                               {{0.0, {1, 1, 1, 0}},
+                                {0.1, {1, 1, 1, 0}},
+                                {0.4, {1, 0.6, 0.2, 0.06}},
+                                {1.0, {1, 1, 1, 0.3}}},
+                               level, level)};
+    const std::string what = "level " + std::to_string(level);
+    FrameOptions o;
+    o.mode = RenderMode::pagetable;
+    const Rendered pt = render_cpu(rs, s, o);
+    o.mode = RenderMode::residency;
+    const Rendered res = render_cpu(rs, s, o);
+    ASSERT_GT(pt.stats.distance_skipped, 0.0) << what;
+    // Level 1 without the brick skip: 165.1 of the page table's 245.3 box units.
+    EXPECT_NEAR(res.stats.distance_skipped, pt.stats.distance_skipped,
+                1e-6 * pt.stats.distance_skipped)
+        << what;
+    EXPECT_EQ(res.stats.samples, pt.stats.samples) << what;
+    EXPECT_LT(max_diff(res.image, pt.image), 2e-4) << what;
+  }
+}
+
 }  // namespace
 }  // namespace resoct::test

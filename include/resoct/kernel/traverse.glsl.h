@@ -534,6 +534,14 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
           seg_homog = class_homog;
           seg_node_dep = false;
           if (f.mode == RESOCT_MODE_RESIDENCY) {
+            // Channels the node does not settle may still be settled by their bricks: an EMPTY
+            // brick (page state) is transparent over its box, as in page-table mode. When every
+            // channel is settled one way or the other, the march skips to the first place where
+            // one of them stops holding, instead of stepping through samples that add nothing.
+            bool all_empty = (live & ~class_empty) != 0u;
+            RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
+              all_empty = false;
+            }
             for (uint c = 0u; c < n; ++c) {
               src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
               if ((((live & ~class_empty) >> c) & 1u) == 0u) continue;
@@ -555,6 +563,14 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
                   seg_node_dep = true;
                 }
               }
+              if (src[c].kind != RESOCT_CH_EMPTY) all_empty = false;
+            }
+            if (all_empty) {
+              // The node's classes hold until node_t_end, the bricks over [src_lo, src_hi), the
+              // bricks' level until lod_t_end (a finer level's bricks need not be empty).
+              skip = true;
+              skip_exit = min(min(node_t_end, lod_t_end - tm),
+                              resoct_box_exit_t(cell, frac, inv_vox, src_lo, src_hi));
             }
           } else {
             // Page-table and standard-octree modes: channels independently; skip only when every
