@@ -37,6 +37,22 @@ Scene sphere_scene(double alpha_at_zero) {
   return s;
 }
 
+// A cube of `edge` u8 voxels holding a ball of 255 (radius 21/64 of the edge, a little off the
+// centre) in zeros: a "binary mask", whose values are 0 or 255 only.
+VolumeDesc binary_ball_volume(std::uint32_t edge) {
+  VolumeDesc v;
+  v.extent = {edge, edge, edge};
+  v.type = VoxelType::u8;
+  return v;
+}
+FunctionSource::ValueFn binary_ball(std::uint32_t edge) {
+  const double k = edge / 32.0;
+  return [k](std::uint32_t, const glm::u64vec3& p) {
+    const glm::dvec3 d = glm::dvec3(p) + 0.5 - k * glm::dvec3(16.0, 14.0, 17.0);
+    return glm::dot(d, d) < (10.5 * k) * (10.5 * k) ? 255.0 : 0.0;
+  };
+}
+
 void expect_reference(const Rendered& r, const Image& ref, const std::string& what) {
   EXPECT_LT(max_diff(r.image, ref), kRefMax) << what;
   EXPECT_LT(compare_images(r.image, ref).rmse_rgb, kRefRmse) << what;
@@ -66,13 +82,8 @@ TEST(ExactCulling, OpacityAtZeroRendersInEveryMode) {
 // only in a band in the middle shows the mask's boundary surface: no node may be culled because
 // its voxels' bins miss the band (the occupancy test did exactly that).
 TEST(ExactCulling, BandsBetweenOccupiedValuesAreNotCulled) {
-  VolumeDesc v;
-  v.extent = {32, 32, 32};
-  v.type = VoxelType::u8;
-  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
-    const glm::dvec3 d = glm::dvec3(p) + 0.5 - glm::dvec3(16.0, 14.0, 17.0);
-    return glm::dot(d, d) < 10.5 * 10.5 ? 255.0 : 0.0;
-  });
+  const VolumeDesc v = binary_ball_volume(32);
+  FunctionSource src(v, bricks8(), binary_ball(32));
   ResidentOptions ro;
   ro.leaf_size = glm::uvec3(4);
   ResidentScene rs(src, {0}, ro);
@@ -214,13 +225,7 @@ TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
 // the leaves are the sampled level's bricks, so no node is empty where its brick is not: the
 // residency mode skips exactly the page table's distance and renders its image.
 TEST(ExactCulling, EmptyBricksInTheRimOfEmptyNodesAreSkipped) {
-  VolumeDesc v;
-  v.extent = {64, 64, 64};
-  v.type = VoxelType::u8;
-  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
-    const glm::dvec3 d = glm::dvec3(p) + 0.5 - glm::dvec3(32.0, 28.0, 34.0);
-    return glm::dot(d, d) < 21.0 * 21.0 ? 255.0 : 0.0;
-  });
+  FunctionSource src(binary_ball_volume(64), bricks8(), binary_ball(64));
   for (std::uint32_t level : {0u, 1u}) {
     ResidentOptions ro;
     ro.leaf_size = glm::uvec3(8u << level);
