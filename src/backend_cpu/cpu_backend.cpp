@@ -165,6 +165,7 @@ void CpuBackend::render(const FrameTables& tables, FrameResult& result) {
   c.tf = tables.tf_luts.data();
   c.preint = tables.preint_tables.data();
   c.step_luts = tables.step_luts.data();
+  c.visible_subtrees = tables.visible_subtrees.empty() ? nullptr : tables.visible_subtrees.data();
   c.fx = &tables.fx;
   c.cache = cache_.data();
   c.slot_voxels = slot_voxels_;

@@ -54,8 +54,9 @@ struct KernelContext {
   const kernel::ResoctLevelInfo* levels = nullptr;
   const kernel::ResoctDepthInfo* depths = nullptr;
   const glm::vec4* tf = nullptr;
-  const glm::vec4* preint = nullptr;     // pre-integration tables (empty frame: unused)
-  const glm::vec4* step_luts = nullptr;  // corrected, premultiplied LUTs per step level
+  const glm::vec4* preint = nullptr;                // pre-integration tables (empty frame: unused)
+  const glm::vec4* step_luts = nullptr;             // corrected, premultiplied LUTs per step level
+  const std::uint32_t* visible_subtrees = nullptr;  // one word per node; null: all zero
   const kernel::ResoctFxFrame* fx = nullptr;
   const std::byte* cache = nullptr;
   std::size_t slot_voxels = 0;
@@ -150,6 +151,10 @@ inline vec4 resoct_read_preint(uint slot, uint index) {
 }
 inline vec4 resoct_read_step_lut(uint index) {
   return cpu::detail::t_ctx->step_luts[index];
+}
+inline uint resoct_read_visible_subtrees(uint node) {
+  const std::uint32_t* bits = cpu::detail::t_ctx->visible_subtrees;
+  return bits != nullptr ? bits[node] : 0u;
 }
 inline ResoctFxFrame resoct_read_fx_frame() {
   return *cpu::detail::t_ctx->fx;

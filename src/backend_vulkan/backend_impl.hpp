@@ -49,9 +49,10 @@ enum Binding : std::uint32_t {
   b_stats,
   b_cache1,  // cache chunks 1..7 (chunk 0 is b_cache)
   b_cache7 = b_cache1 + 6,
-  b_directory,  // the page directory (binding 21)
-  b_preint,     // pre-integration tables (binding 22)
-  b_step_luts,  // corrected LUTs of the step levels (binding 23)
+  b_directory,         // the page directory (binding 21)
+  b_preint,            // pre-integration tables (binding 22)
+  b_step_luts,         // corrected LUTs of the step levels (binding 23)
+  b_visible_subtrees,  // one word per octree node (binding 24)
   binding_count
 };
 
@@ -116,6 +117,10 @@ struct VulkanBackend::Impl {
   // FrameTables::step_luts_version of the step LUTs the device holds (0: none): they are re-sent
   // only when the tables' version differs (several MiB with many channels) or the buffer is new.
   std::uint64_t step_luts_on_device = 0;
+  // FrameTables::visible_subtrees_version of the bits the device holds (0: unknown,
+  // kZeroVisibleSubtrees: all zero, what tables without bits mean); re-sent only on change.
+  static constexpr std::uint64_t kZeroVisibleSubtrees = ~std::uint64_t(0);
+  std::uint64_t visible_subtrees_on_device = 0;
   bool recording = false;  // `cmd` holds an unsubmitted batch
 
   BackendConfig config{};

@@ -167,6 +167,15 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   ensure(b_step_luts, std::max<std::size_t>(tables.step_luts.size(), 1) * sizeof(glm::vec4),
          "step-level LUTs");
   if (buf[b_step_luts].buffer != step_luts_before) step_luts_on_device = 0;
+  // One word per node whether or not the tables have bits: the kernel reads any node's word.
+  const kernel::ResoctDepthInfo& last_depth = tables.depths.back();
+  const std::size_t node_count =
+      std::size_t(last_depth.first_node) +
+      std::size_t(last_depth.count_x) * last_depth.count_y * last_depth.count_z;
+  const VkBuffer visible_before = buf[b_visible_subtrees].buffer;
+  ensure(b_visible_subtrees, std::max<std::size_t>(node_count, 1) * sizeof(std::uint32_t),
+         "visible subtrees");
+  if (buf[b_visible_subtrees].buffer != visible_before) visible_subtrees_on_device = 0;
   ensure(b_out, pixels * sizeof(glm::vec4), "output image");
   begin_batch();
   // ResoctFrame followed by ResoctFxFrame (render.comp's FrameBuf).
@@ -184,6 +193,15 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
   if (!tables.step_luts.empty() &&
       (tables.step_luts_version == 0 || tables.step_luts_version != step_luts_on_device)) {
     stage_copy(buf[b_step_luts].buffer, 0, std::as_bytes(std::span(tables.step_luts)));
+  }
+  if (tables.visible_subtrees.empty()) {
+    if (visible_subtrees_on_device != kZeroVisibleSubtrees) {
+      vkCmdFillBuffer(cmd, buf[b_visible_subtrees].buffer, 0, VK_WHOLE_SIZE, 0);
+    }
+  } else if (tables.visible_subtrees_version == 0 ||
+             tables.visible_subtrees_version != visible_subtrees_on_device) {
+    stage_copy(buf[b_visible_subtrees].buffer, 0,
+               std::as_bytes(std::span(tables.visible_subtrees)));
   }
 }
 

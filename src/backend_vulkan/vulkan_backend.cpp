@@ -186,6 +186,7 @@ void VulkanBackend::configure(const BackendConfig& config) {
   // The pipeline is built by the first render(): compiling the kernel takes seconds on CPU
   // devices, and a configuration that is only updated never needs it.
   m.step_luts_on_device = 0;
+  m.visible_subtrees_on_device = 0;
   m.configured = true;
 }
 
@@ -245,9 +246,12 @@ void VulkanBackend::render(const FrameTables& tables, FrameResult& result) {
   // Compiling the kernel is slow (seconds on lavapipe): the cache compiles each variant once.
   const VkPipeline pipeline = m.render_pipelines->get(m.render_variant(tables));
   m.step_luts_on_device = 0;  // until the frame that sends them has run
+  m.visible_subtrees_on_device = 0;
   m.record_render(tables, pipeline);
   m.flush();
   m.step_luts_on_device = tables.step_luts_version;
+  m.visible_subtrees_on_device = tables.visible_subtrees.empty() ? Impl::kZeroVisibleSubtrees
+                                                                 : tables.visible_subtrees_version;
   invalidate(*m.ctx, m.readback);
   m.read_results(tables.frame, tables.image_to_host, result);
   result.stats.ms_render =

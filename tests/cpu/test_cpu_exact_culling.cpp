@@ -217,6 +217,53 @@ TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
   }
 }
 
+// A voxel checkerboard of 10 and 240 under a transfer function that hides [0, 0.1]: every node's
+// range [10, 240] holds hidden values, so no record proves its node wholly visible
+// (resoct_node_full), yet no node is EMPTY. The frame's visible-subtree bits (built on the host
+// from every node below, render/visible_subtrees.hpp) end the descent at the root: one node per
+// ray instead of a descent per 4³ leaf, the page table's samples and image to the bit. Without
+// the bits the same tables descend to the leaves.
+TEST(ExactCulling, VisibleSubtreesEndTheDescentWhereEveryNodeStraddlesHiddenValues) {
+  VolumeDesc v;
+  v.extent = {32, 32, 32};
+  v.type = VoxelType::u8;
+  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
+    return (p.x + p.y + p.z) % 2 == 0 ? 240.0 : 10.0;
+  });
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(4);
+  ResidentScene rs(src, {0}, ro);
+  Scene s = make_scene(40, oblique_camera());
+  s.channels = {make_channel(0,
+                             {{0.0, {1, 1, 1, 0}},
+                              {0.1, {1, 1, 1, 0}},
+                              {0.15, {0.9, 0.6, 0.2, 0.05}},
+                              {1.0, {1, 1, 1, 0.2}}},
+                             0, 0)};
+  FrameOptions o;
+  o.mode = RenderMode::pagetable;
+  const Rendered pt = render_cpu(rs, s, o);
+  o.mode = RenderMode::residency;
+  FrameTables with = rs.tables(s, o);
+  ASSERT_FALSE(with.visible_subtrees.empty());
+  EXPECT_EQ(with.visible_subtrees[0], 1u) << "the root's subtree is visible for entry 0";
+  FrameTables without = with;
+  without.visible_subtrees.clear();
+  cpu::CpuBackend backend(1);
+  rs.upload(backend);
+  FrameResult a;
+  backend.render(with, a);
+  FrameResult b;
+  backend.render(without, b);
+  ASSERT_GT(pt.stats.samples, 0u);
+  EXPECT_EQ(a.stats.samples, pt.stats.samples);
+  EXPECT_EQ(max_diff(a.image, pt.image), 0.0);
+  EXPECT_LE(a.stats.nodes_visited, a.stats.rays);
+  EXPECT_EQ(b.stats.samples, pt.stats.samples);
+  EXPECT_GT(b.stats.nodes_visited, 2 * b.stats.rays);
+  EXPECT_EQ(max_diff(b.image, pt.image), 0.0);
+}
+
 // Where a channel samples a coarse level, a node's class holds only inside the node shrunk by
 // half a voxel of that level (the trilinear support reaches that far beyond it); in the rim that
 // is left, every channel is looked up. An all-zero brick there is an EMPTY page, which settles

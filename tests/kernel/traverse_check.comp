@@ -41,6 +41,9 @@ layout(std430, binding = 21) readonly buffer PreintTables {
 layout(std430, binding = 22) readonly buffer StepLuts {
   vec4 step_lut_entries[];
 };
+layout(std430, binding = 23) readonly buffer VisibleSubtrees {
+  uint visible_subtree_words[];
+};
 layout(std430, binding = 8) readonly buffer Cache {
   float cache_voxels[];
 };
@@ -92,6 +95,9 @@ vec4 resoct_read_preint(uint slot, uint index) {
 }
 vec4 resoct_read_step_lut(uint index) {
   return step_lut_entries[index];
+}
+uint resoct_read_visible_subtrees(uint node) {
+  return visible_subtree_words[node];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;

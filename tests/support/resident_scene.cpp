@@ -5,6 +5,7 @@
 
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
+#include "resoct/render/visible_subtrees.hpp"
 
 namespace resoct::test {
 
@@ -113,7 +114,10 @@ void ResidentScene::upload(Backend& backend) const {
 }
 
 FrameTables ResidentScene::tables(const Scene& scene, const FrameOptions& options) const {
-  return build_frame_tables(scene, source_.hierarchy(), layout_, channels_, options);
+  FrameTables t = build_frame_tables(scene, source_.hierarchy(), layout_, channels_, options);
+  // As the Renderer does: residency-mode tables carry the octree's visible-subtree bits.
+  build_visible_subtrees(*octree_, t);
+  return t;
 }
 
 PageAddress ResidentScene::decode(std::uint32_t device_key) const {

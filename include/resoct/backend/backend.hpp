@@ -110,6 +110,15 @@ struct FrameTables {
   std::uint64_t step_luts_version = 0;
   /// Transfer-function LUTs the last build computed; the other slots' LUTs were kept.
   std::uint32_t luts_built = 0;
+  /// Residency mode: one word per octree node whose bit i says that slot-table entry i finds no
+  /// node at or below it that its transfer function hides or whose metadata is missing
+  /// (render/visible_subtrees.hpp); the traversal then marches the node's box as one visible
+  /// node. Empty: no node has bits (what a backend must read as all zero). Built by the Renderer
+  /// from the octree it sends, not by build_frame_tables; otherwise empty.
+  std::vector<std::uint32_t> visible_subtrees;
+  /// Changes (process-wide counter) whenever visible_subtrees does; equal versions mean equal
+  /// contents, 0 means "not versioned" (always send).
+  std::uint64_t visible_subtrees_version = 0;
   /// Whether render() must copy the image into host memory (FrameResult::image). When false, a
   /// backend that renders into device memory leaves the pixels there, describes them in
   /// FrameResult::device_image and leaves FrameResult::image as it was; a backend that renders

@@ -19,6 +19,9 @@
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
 //   vec4  resoct_read_preint(uint slot, uint index)  (preintegration.glsl.h)
 //   vec4  resoct_read_step_lut(uint index)           (step_lut.glsl.h)
+//   uint  resoct_read_visible_subtrees(uint node)    bit i: slot-table entry i finds no hidden or
+//                                                    unknown node at or below `node`
+//                                                    (render/visible_subtrees.hpp); 0 if none
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
 //   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
 //
@@ -391,11 +394,16 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
               }
               if (full_stops) {
                 // Channel ci is visible here; when it and every later live channel are full, no
-                // node below can be skipped for them: this node is the traversal node.
+                // node below can be skipped for them: this node is the traversal node. Full is
+                // the frame's visible-subtree bit (every node below checked on the host), or the
+                // node's own record when its range proves it.
+                uint visible_below = resoct_read_visible_subtrees(nd);
                 bool full = true;
                 for (uint c = ci; c < n && full; ++c) {
                   if (((live >> c) & 1u) != 0u) {
-                    full = resoct_node_full(nd, resoct_read_slot(bank + c), f.node_slot_count);
+                    uint e = bank + c;
+                    full = (e < RESOCT_MAX_SLOTS && ((visible_below >> e) & 1u) != 0u) ||
+                           resoct_node_full(nd, resoct_read_slot(e), f.node_slot_count);
                   }
                 }
                 if (full) {

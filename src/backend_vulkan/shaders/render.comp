@@ -75,6 +75,11 @@ layout(std430, binding = 22) readonly buffer PreintTables {
 layout(std430, binding = 23) readonly buffer StepLuts {
   vec4 step_lut_entries[];
 };
+// Per octree node: the frame's visible-subtree bits (render/visible_subtrees.hpp), all zero when
+// the tables have none.
+layout(std430, binding = 24) readonly buffer VisibleSubtrees {
+  uint visible_subtree_words[];
+};
 layout(std430, binding = 8) readonly buffer Cache0 {
   uint cache0[];
 };
@@ -188,6 +193,9 @@ vec4 resoct_read_preint(uint slot, uint index) {
 }
 vec4 resoct_read_step_lut(uint index) {
   return step_lut_entries[index];
+}
+uint resoct_read_visible_subtrees(uint node) {
+  return visible_subtree_words[node];
 }
 ResoctFxFrame resoct_read_fx_frame() {
   return fx_frame;

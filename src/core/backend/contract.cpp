@@ -66,6 +66,13 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
       config.node_words != 0) {
     fail("octree is smaller than the depth table");
   }
+  // One word per node of the depth table, or none.
+  const std::uint64_t nodes =
+      std::uint64_t(t.depths.back().first_node) +
+      std::uint64_t(t.depths.back().count_x) * t.depths.back().count_y * t.depths.back().count_z;
+  if (!t.visible_subtrees.empty() && t.visible_subtrees.size() != nodes) {
+    fail("visible_subtrees size differs from the depth table's node count");
+  }
   if (glm::uvec3(f.padded_x, f.padded_y, f.padded_z) != config.padded_brick) {
     fail("padded brick size differs from the configuration");
   }

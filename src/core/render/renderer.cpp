@@ -1,6 +1,7 @@
 #include "resoct/render/renderer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <limits>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include "resoct/engine/prefetch.hpp"
 #include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
+#include "resoct/render/visible_subtrees.hpp"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
@@ -264,6 +266,7 @@ void Renderer::Impl::send_update(FrameStats& stats) {
     stats.page_deltas = page_deltas.pool.size() + page_deltas.directory.size();
   }
   const OctreeDeltas node_deltas = octree_->take_deltas();
+  if (send_full_ || node_deltas.full || !node_deltas.words.empty()) octree_changed_ = true;
   if (send_full_ || node_deltas.full) {
     u.nodes_full = true;
     u.all_nodes = octree_->words();
@@ -436,7 +439,30 @@ const FrameTables& Renderer::Impl::frame_tables(const Scene& scene, const FrameJ
   // transfer functions that changed are computed again (FrameTables::lut_sources).
   build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
   tables_.image_to_host = options_.output != FrameOutput::device;
+  update_visible_subtrees();
   return tables_;
+}
+
+void Renderer::Impl::update_visible_subtrees() {
+  if (options_.mode != RenderMode::residency) {
+    build_visible_subtrees(*octree_, tables_);  // clears them
+    return;
+  }
+  // Rebuilt only when the octree's words or what the bits are computed from changed: with a
+  // still scene and a converged cache, never.
+  VisibleSubtreesKey key;
+  key.depth_limit =
+      deepest_traversal_depth(tables_.frame, tables_.levels, tables_.depths, tables_.slots);
+  key.start_depth = tables_.frame.start_depth;
+  key.entries.reserve(tables_.slots.size() * 4);
+  for (const kernel::ResoctSlotInfo& s : tables_.slots) {
+    key.entries.insert(key.entries.end(), {s.slot, s.vis_bins, s.vis_lo16, s.vis_hi16});
+  }
+  if (octree_changed_ || key != visible_subtrees_key_ || tables_.visible_subtrees_version == 0) {
+    build_visible_subtrees(*octree_, tables_);
+    visible_subtrees_key_ = std::move(key);
+    octree_changed_ = false;
+  }
 }
 
 FrameReport Renderer::render_frame(const Scene& scene) {

@@ -64,6 +64,8 @@ struct Renderer::Impl {
   void render_frame(const Scene& scene, FrameReport& report, const FrameJitter& jitter);
 
   const FrameTables& frame_tables(const Scene& scene, const FrameJitter& jitter);
+  // Rebuilds tables_.visible_subtrees (residency mode) when the octree or its inputs changed.
+  void update_visible_subtrees();
   void take_pixels(FrameReport& report);
   void assign_channels(const Scene& scene);
   void switch_timepoint(std::uint32_t t);
@@ -121,6 +123,16 @@ struct Renderer::Impl {
   std::vector<std::shared_ptr<const HostBrick>> upload_data_;
   std::vector<BrickUpload> uploads_;
   FrameTables tables_;
+  // What tables_.visible_subtrees was built from besides the octree's words: rebuilt when these
+  // differ or the octree changed (octree_changed_, set by send_update).
+  struct VisibleSubtreesKey {
+    std::uint32_t depth_limit = 0;
+    std::uint32_t start_depth = 0;
+    std::vector<std::uint32_t> entries;  // per slot-table entry: slot, vis_bins, vis_lo16, vis_hi16
+    bool operator==(const VisibleSubtreesKey&) const = default;
+  };
+  VisibleSubtreesKey visible_subtrees_key_;
+  bool octree_changed_ = true;
   FrameResult result_;
 };
 

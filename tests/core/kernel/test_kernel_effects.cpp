@@ -60,6 +60,10 @@ inline vec4 resoct_read_preint(uint slot, uint index) {
 inline vec4 resoct_read_step_lut(uint index) {
   return test::g.tables->step_luts[index];
 }
+inline uint resoct_read_visible_subtrees(uint node) {
+  const auto& bits = test::g.tables->visible_subtrees;
+  return bits.empty() ? 0u : bits[node];
+}
 inline ResoctFxFrame resoct_read_fx_frame() {
   return test::g.tables->fx;
 }

@@ -1,6 +1,9 @@
 #include "core/render/test_renderer_support.hpp"
 
+#include <algorithm>
+
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/render/visible_subtrees.hpp"
 #include "resoct/sources/procedural_source.hpp"
 #include "support/expect_error.hpp"
 
@@ -186,6 +189,49 @@ TEST(Renderer, NodeRequestsAreAnsweredFromRegionMetadata) {
               kernel::RESOCT_NODE_VALID);
   }
   EXPECT_EQ(check_state(r, *b, *src), "");
+}
+
+// The renderer rebuilds the visible-subtree bits only when the octree's words or the transfer
+// functions changed, yet every frame's bits are those of its octree and scene: compared with a
+// fresh build from the octree as the backend holds it, on each frame of a converging cache
+// (node metadata answered, brick metadata arriving) and after a change of transfer function.
+TEST(Renderer, VisibleSubtreeBitsFollowTheOctreeAndTheTransferFunctions) {
+  auto src = make_test_source();
+  register_test_backend();
+  RendererOptions o = test_options(256, 8);
+  o.start_depth = 0;  // the tree has three depths: bits at the root and its children
+  Renderer r(src, o);
+  RecordingBackend* b = last_recording_backend();
+  std::uint32_t frames = 0, rebuilt = 0, with_bits = 0;
+  std::uint64_t last_version = 0;
+  const std::uint32_t nodes = std::uint32_t(inspect::layout(r).node_count());
+  b->set_script([&](const FrameTables& t, FrameResult& res, RecordingBackend&) {
+    ++frames;
+    // The recording backend does not march: ask for the nodes' metadata, as rays would, one node
+    // per frame, so that the octree changes by a few words at a time (deltas, not full uploads).
+    if (frames <= nodes) res.node_requests.push_back(Request{frames - 1, 1, 0});
+    FrameTables fresh = t;
+    build_visible_subtrees(inspect::octree(r), fresh);
+    EXPECT_EQ(t.visible_subtrees, fresh.visible_subtrees) << "frame " << frames;
+    if (t.visible_subtrees_version != last_version) ++rebuilt;
+    last_version = t.visible_subtrees_version;
+    if (std::any_of(t.visible_subtrees.begin(), t.visible_subtrees.end(),
+                    [](std::uint32_t w) { return w != 0u; })) {
+      ++with_bits;
+    }
+  });
+  Scene scene = test_scene(1);
+  // Shows every value but 0 (the zeros below x = 9 are hidden).
+  scene.channels[0].tf =
+      TransferFunction({{0.0, {1, 1, 1, 0}}, {0.002, {1, 1, 1, 0.5}}, {1.0, {1, 1, 1, 1}}});
+  for (std::uint32_t i = 0; i < nodes + 5; ++i) r.render_frame(scene);
+  const std::uint32_t rebuilt_before = rebuilt;
+  EXPECT_GT(with_bits, 0u) << "the comparison saw bits";
+  scene.channels[0].tf =
+      TransferFunction({{0.0, {1, 1, 1, 0}}, {0.6, {1, 1, 1, 0}}, {1.0, {1, 1, 1, 1}}});
+  for (int i = 0; i < 5; ++i) r.render_frame(scene);
+  EXPECT_GT(rebuilt, rebuilt_before) << "a new transfer function rebuilds them";
+  EXPECT_LT(rebuilt, frames) << "frames with nothing changed reuse them";
 }
 
 TEST(Renderer, RejectsBadOptionsAndScenes) {

@@ -1,0 +1,156 @@
+// The frame's visible-subtree bits (render/visible_subtrees.hpp) on a hand-made octree of three
+// depths (1, 8 and 64 nodes; one record slot), against what the residency descent would find:
+// a bit only where no node at or below it, down to the depth limit, is hidden or unknown.
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "resoct/base/error.hpp"
+#include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/render/visible_subtrees.hpp"
+
+namespace resoct::test {
+namespace {
+
+namespace k = resoct::kernel;
+
+constexpr std::uint32_t kNodes = 1 + 8 + 64;
+
+std::vector<k::ResoctDepthInfo> depths() {
+  std::vector<k::ResoctDepthInfo> out;
+  std::uint32_t first = 0;
+  for (std::uint32_t d = 0; d < 3; ++d) {
+    k::ResoctDepthInfo D{};
+    D.count_x = D.count_y = D.count_z = 1u << d;
+    D.count_log2_x = D.count_log2_y = D.count_log2_z = d;
+    D.child_shift = d == 0 ? 0u : 3u;
+    D.split_x = D.split_y = D.split_z = d == 0 ? 0u : 1u;
+    D.first_node = first;
+    D.node_extent_x = D.node_extent_y = D.node_extent_z = 32u >> d;
+    first += D.count_x * D.count_y * D.count_z;
+    out.push_back(D);
+  }
+  return out;
+}
+
+// A transfer function that shows [lo, 1] (normalized): its quantized hull and bins.
+k::ResoctSlotInfo shows_from(double lo) {
+  k::ResoctSlotInfo s{};
+  s.slot = 0;
+  s.vis_lo16 = std::uint32_t(lo * 65535.0);
+  s.vis_hi16 = 65535u;
+  s.vis_bins = 0xFFFFFFFFu << (s.vis_lo16 >> 11u);
+  return s;
+}
+
+struct Tree {
+  std::vector<std::uint32_t> words = std::vector<std::uint32_t>(kNodes * k::RESOCT_NODE_WORDS, 0u);
+  // Every node VALID with the range [0.3, 0.9].
+  Tree() {
+    for (std::uint32_t n = 0; n < kNodes; ++n) set(n, k::RESOCT_NODE_VALID, 0.3, 0.9);
+  }
+  void set(std::uint32_t node, std::uint32_t state, double lo, double hi) {
+    const std::uint32_t base = node * k::RESOCT_NODE_WORDS;
+    words[base + k::RESOCT_NODE_FLAGS] = k::resoct_node_make_flags(state, 0u);
+    words[base + k::RESOCT_NODE_MINMAX] =
+        k::resoct_node_pack_minmax(std::uint32_t(lo * 65535.0), std::uint32_t(hi * 65535.0));
+  }
+  std::vector<std::uint32_t> bits(std::vector<k::ResoctSlotInfo> slots, std::uint32_t start = 0,
+                                  std::uint32_t limit = 2) const {
+    std::vector<std::uint32_t> out;
+    build_visible_subtrees(words, 1, depths(), slots, start, limit, out);
+    return out;
+  }
+};
+
+// Leaf 37 (depth 2, local 28) lies in depth-1 node local 3 (node 4).
+constexpr std::uint32_t kLeaf = 9 + 28;
+constexpr std::uint32_t kLeafParent = 1 + 3;
+
+TEST(VisibleSubtrees, EveryNodeShownSetsEveryBitAboveTheLimit) {
+  const auto bits = Tree().bits({shows_from(0.1)});
+  ASSERT_EQ(bits.size(), kNodes);
+  for (std::uint32_t n = 0; n < 9; ++n) EXPECT_EQ(bits[n], 1u) << "node " << n;
+  for (std::uint32_t n = 9; n < kNodes; ++n) EXPECT_EQ(bits[n], 0u) << "leaf " << n;
+}
+
+TEST(VisibleSubtrees, AHiddenOrUnknownLeafClearsItsAncestors) {
+  for (std::uint32_t state : {k::RESOCT_NODE_VALID, k::RESOCT_NODE_INVALID}) {
+    Tree t;
+    t.set(kLeaf, state, 0.0, 0.05);  // hidden below 0.1 (VALID) or unknown (INVALID)
+    const auto bits = t.bits({shows_from(0.1)});
+    EXPECT_EQ(bits[0], 0u) << "state " << state;
+    for (std::uint32_t n = 1; n < 9; ++n) {
+      EXPECT_EQ(bits[n], n == kLeafParent ? 0u : 1u) << "state " << state << ", node " << n;
+    }
+  }
+}
+
+TEST(VisibleSubtrees, ARangeThatStraddlesHiddenValuesIsNotHidden) {
+  Tree t;
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.2);  // hidden below 0.1, but reaches past it
+  EXPECT_EQ(t.bits({shows_from(0.1)})[0], 1u);
+}
+
+TEST(VisibleSubtrees, AHomogeneousNodeHasNoBitButItsParentHas) {
+  Tree t;
+  t.set(kLeafParent, k::RESOCT_NODE_VALID, 0.5, 0.5);
+  const auto bits = t.bits({shows_from(0.1)});
+  EXPECT_EQ(bits[kLeafParent], 0u) << "its value is used without sampling";
+  EXPECT_EQ(bits[0], 1u) << "below the root it is sampled, to the same value";
+}
+
+TEST(VisibleSubtreesLimits, NodesPastTheDepthLimitOrAboveTheStartAreNotRead) {
+  Tree t;
+  t.set(kLeaf, k::RESOCT_NODE_INVALID, 0.0, 0.0);
+  const auto to_depth_1 = t.bits({shows_from(0.1)}, 0, 1);
+  EXPECT_EQ(to_depth_1[0], 1u) << "no ray descends to the unknown leaf";
+  for (std::uint32_t n = 1; n < kNodes; ++n) EXPECT_EQ(to_depth_1[n], 0u) << "node " << n;
+  const auto from_depth_1 = Tree().bits({shows_from(0.1)}, 1, 2);
+  EXPECT_EQ(from_depth_1[0], 0u);
+  EXPECT_EQ(from_depth_1[1], 1u);
+}
+
+TEST(VisibleSubtreesLimits, EachSlotTableEntryHasItsOwnBit) {
+  k::ResoctSlotInfo hides_all = shows_from(0.95);  // the data's values end at 0.9
+  k::ResoctSlotInfo invisible{};                   // shows nothing: not live, no bit
+  const auto bits = Tree().bits({shows_from(0.1), hides_all, invisible, shows_from(0.0)});
+  EXPECT_EQ(bits[0], 0b1001u);
+}
+
+TEST(VisibleSubtreesLimits, ShortOctreesAndForeignSlotsAreRejected) {
+  Tree t;
+  std::vector<std::uint32_t> out;
+  const std::vector<std::uint32_t> short_words(t.words.begin(), t.words.end() - 1);
+  EXPECT_THROW(
+      build_visible_subtrees(short_words, 1, depths(), std::vector{shows_from(0.1)}, 0, 2, out),
+      Error);
+  k::ResoctSlotInfo foreign = shows_from(0.1);
+  foreign.slot = 1;
+  EXPECT_THROW(build_visible_subtrees(t.words, 1, depths(), std::vector{foreign}, 0, 2, out),
+               Error);
+}
+
+// The depth limit is the deepest traversal depth of any ray: an axis-aligned ray's step, and the
+// finest level any shown entry samples.
+TEST(VisibleSubtreesLimits, TheDepthLimitFollowsTheShortestStepAndTheFinestLevel) {
+  k::ResoctFrame f{};
+  f.voxels_per_box_x = f.voxels_per_box_y = f.voxels_per_box_z = 32.0f;
+  f.finest_voxel_x = f.finest_voxel_y = f.finest_voxel_z = 1.0f / 32.0f;
+  f.step_scale = 1.0f;
+  f.ref_step = 1.0f / 32.0f;
+  std::vector<k::ResoctLevelInfo> levels(4);
+  for (std::uint32_t l = 0; l < 4; ++l) {
+    levels[l].factor_log2_x = levels[l].factor_log2_y = levels[l].factor_log2_z = l;
+  }
+  k::ResoctSlotInfo s = shows_from(0.1);
+  EXPECT_EQ(deepest_traversal_depth(f, levels, depths(), std::vector{s}), 2u);
+  s.finest_level = 3;  // 8-voxel leaves hold one level-3 voxel: depth 1 (two of them)
+  EXPECT_EQ(deepest_traversal_depth(f, levels, depths(), std::vector{s}), 1u);
+  s.finest_level = 0;
+  f.step_scale = 10.0f;  // steps of 10 voxels: nodes of 16 are the smallest that long
+  EXPECT_EQ(deepest_traversal_depth(f, levels, depths(), std::vector{s}), 1u);
+}
+
+}  // namespace
+}  // namespace resoct::test
