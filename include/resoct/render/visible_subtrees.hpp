@@ -37,14 +37,15 @@ std::uint32_t deepest_traversal_depth(const kernel::ResoctFrame& frame,
 /// - a record with metadata (not INVALID: the descent would request it, and its answer may cull),
 /// - a value range the entry's transfer function shows (not EMPTY: the descent would skip it),
 /// and the node's own record is not homogeneous (a homogeneous node's value is used without
-/// sampling; homogeneous nodes below are sampled instead, to the same values). Nodes at depths
-/// below `start_depth` or at and below `depth_limit` get 0. `words` are ResidencyOctree::words()
-/// with `node_slots` records per node (kernel/octree_node.glsl.h).
+/// sampling; homogeneous nodes below are sampled instead, to the same values). Nodes wholly
+/// outside the volume [0, `extent`) (level-0 voxels), which no ray reaches, count as shown. Nodes
+/// at depths below `start_depth` or at and below `depth_limit` get 0. `words` are
+/// ResidencyOctree::words() with `node_slots` records per node (kernel/octree_node.glsl.h).
 /// Throws Error(invalid_argument) naming "octree" when `words` is shorter than the depth table's
 /// nodes, or "slots" when an entry names a slot at or past `node_slots`.
 void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t node_slots,
                             std::span<const kernel::ResoctDepthInfo> depths,
-                            std::span<const kernel::ResoctSlotInfo> slots,
+                            std::span<const kernel::ResoctSlotInfo> slots, glm::uvec3 extent,
                             std::uint32_t start_depth, std::uint32_t depth_limit,
                             std::vector<std::uint32_t>& out);
 

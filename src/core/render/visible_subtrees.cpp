@@ -63,6 +63,25 @@ bool record_shown(std::span<const std::uint32_t> words, std::uint32_t node,
   return true;
 }
 
+// The coordinate a local index holds in the bits `mask` (ResoctDepthInfo::axis_bits_*): the
+// mask's bits from the lowest up are the coordinate's from its least significant bit.
+std::uint32_t extract_bits(std::uint32_t local, std::uint32_t mask) {
+  std::uint32_t out = 0;
+  for (std::uint32_t bit = 0; mask != 0u; mask &= mask - 1u, ++bit) {
+    if ((local & mask & (~mask + 1u)) != 0u) out |= 1u << bit;
+  }
+  return out;
+}
+
+// Whether the node's box lies wholly outside the volume [0, extent): the octree's node counts are
+// powers of two, so its last nodes along an axis may hold no voxel. No ray reaches them (rays are
+// clipped to the volume) and their records stay INVALID: they must not clear their ancestors' bits.
+bool outside_volume(const k::ResoctDepthInfo& D, std::uint32_t local, glm::uvec3 extent) {
+  return std::uint64_t(extract_bits(local, D.axis_bits_x)) * D.node_extent_x >= extent.x ||
+         std::uint64_t(extract_bits(local, D.axis_bits_y)) * D.node_extent_y >= extent.y ||
+         std::uint64_t(extract_bits(local, D.axis_bits_z)) * D.node_extent_z >= extent.z;
+}
+
 }  // namespace
 
 std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
@@ -98,8 +117,9 @@ std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
 
 void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t node_slots,
                             std::span<const k::ResoctDepthInfo> depths,
-                            std::span<const k::ResoctSlotInfo> slots, std::uint32_t start_depth,
-                            std::uint32_t depth_limit, std::vector<std::uint32_t>& out) {
+                            std::span<const k::ResoctSlotInfo> slots, glm::uvec3 extent,
+                            std::uint32_t start_depth, std::uint32_t depth_limit,
+                            std::vector<std::uint32_t>& out) {
   out.clear();
   if (depths.empty()) return;
   const k::ResoctDepthInfo& last = depths.back();
@@ -137,6 +157,10 @@ void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t 
     const std::uint32_t child_shift = d < depth_limit ? depths[d + 1].child_shift : 0u;
     ok_here.assign(count, 0u);
     for (std::uint32_t local = 0; local < count; ++local) {
+      if (outside_volume(D, local, extent)) {
+        ok_here[local] = shown;
+        continue;
+      }
       std::uint32_t ok = shown;
       if (d < depth_limit) {
         const std::uint32_t first = local << child_shift;
@@ -167,6 +191,7 @@ void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables) 
   }
   build_visible_subtrees(
       octree.words(), tables.frame.node_slot_count, tables.depths, tables.slots,
+      glm::uvec3(tables.frame.extent_x, tables.frame.extent_y, tables.frame.extent_z),
       tables.frame.start_depth,
       deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots),
       tables.visible_subtrees);

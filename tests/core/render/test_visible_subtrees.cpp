@@ -27,6 +27,12 @@ std::vector<k::ResoctDepthInfo> depths() {
     D.split_x = D.split_y = D.split_z = d == 0 ? 0u : 1u;
     D.first_node = first;
     D.node_extent_x = D.node_extent_y = D.node_extent_z = 32u >> d;
+    // Each depth's child bits below the parent's: x lowest, then y, then z.
+    for (std::uint32_t e = 1; e <= d; ++e) {
+      D.axis_bits_x = (D.axis_bits_x << 3) | 1u;
+      D.axis_bits_y = (D.axis_bits_y << 3) | 2u;
+      D.axis_bits_z = (D.axis_bits_z << 3) | 4u;
+    }
     first += D.count_x * D.count_y * D.count_z;
     out.push_back(D);
   }
@@ -56,9 +62,10 @@ struct Tree {
         k::resoct_node_pack_minmax(std::uint32_t(lo * 65535.0), std::uint32_t(hi * 65535.0));
   }
   std::vector<std::uint32_t> bits(std::vector<k::ResoctSlotInfo> slots, std::uint32_t start = 0,
-                                  std::uint32_t limit = 2) const {
+                                  std::uint32_t limit = 2,
+                                  glm::uvec3 extent = glm::uvec3(32u)) const {
     std::vector<std::uint32_t> out;
-    build_visible_subtrees(words, 1, depths(), slots, start, limit, out);
+    build_visible_subtrees(words, 1, depths(), slots, extent, start, limit, out);
     return out;
   }
 };
@@ -111,6 +118,20 @@ TEST(VisibleSubtreesLimits, NodesPastTheDepthLimitOrAboveTheStartAreNotRead) {
   EXPECT_EQ(from_depth_1[1], 1u);
 }
 
+// The octree's node counts are powers of two: in a volume 20 voxels deep, the leaves at z = 24..31
+// hold no voxel, no ray reaches them and their records stay INVALID. They count as shown.
+TEST(VisibleSubtreesLimits, NodesOutsideTheVolumeDoNotClearTheirAncestors) {
+  Tree t;
+  for (std::uint32_t leaf = 0; leaf < 64; ++leaf) {
+    // z coordinate 3: its high bit from the parent's child bits (bit 5), its low bit (bit 2).
+    if ((leaf & 0b100100u) == 0b100100u) t.set(9 + leaf, k::RESOCT_NODE_INVALID, 0.0, 0.0);
+  }
+  EXPECT_EQ(t.bits({shows_from(0.1)})[0], 0u) << "in a 32-voxel volume they are unknown";
+  const auto bits = t.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32, 32, 20));
+  EXPECT_EQ(bits[0], 1u);
+  for (std::uint32_t n = 1; n < 9; ++n) EXPECT_EQ(bits[n], 1u) << "node " << n;
+}
+
 TEST(VisibleSubtreesLimits, EachSlotTableEntryHasItsOwnBit) {
   k::ResoctSlotInfo hides_all = shows_from(0.95);  // the data's values end at 0.9
   k::ResoctSlotInfo invisible{};                   // shows nothing: not live, no bit
@@ -122,12 +143,13 @@ TEST(VisibleSubtreesLimits, ShortOctreesAndForeignSlotsAreRejected) {
   Tree t;
   std::vector<std::uint32_t> out;
   const std::vector<std::uint32_t> short_words(t.words.begin(), t.words.end() - 1);
-  EXPECT_THROW(
-      build_visible_subtrees(short_words, 1, depths(), std::vector{shows_from(0.1)}, 0, 2, out),
-      Error);
+  EXPECT_THROW(build_visible_subtrees(short_words, 1, depths(), std::vector{shows_from(0.1)},
+                                      glm::uvec3(32u), 0, 2, out),
+               Error);
   k::ResoctSlotInfo foreign = shows_from(0.1);
   foreign.slot = 1;
-  EXPECT_THROW(build_visible_subtrees(t.words, 1, depths(), std::vector{foreign}, 0, 2, out),
+  EXPECT_THROW(build_visible_subtrees(t.words, 1, depths(), std::vector{foreign}, glm::uvec3(32u),
+                                      0, 2, out),
                Error);
 }
 
