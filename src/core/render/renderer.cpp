@@ -1,7 +1,6 @@
 #include "resoct/render/renderer.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <limits>
 #include <mutex>
