@@ -16,6 +16,7 @@
 #include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
 #include "resoct/render/visible_subtrees.hpp"
+#include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
 
@@ -265,7 +266,16 @@ void Renderer::Impl::send_update(FrameStats& stats) {
     stats.page_deltas = page_deltas.pool.size() + page_deltas.directory.size();
   }
   const OctreeDeltas node_deltas = octree_->take_deltas();
-  if (send_full_ || node_deltas.full || !node_deltas.words.empty()) octree_changed_ = true;
+  // The visible-subtree bits read the records' flags and ranges only: bricks arriving change the
+  // residency words every frame of a load, which leaves the bits as they are.
+  if (send_full_ || node_deltas.full) octree_changed_ = true;
+  for (const OctreeWordDelta& d : node_deltas.words) {
+    const std::uint32_t which = d.index % kernel::RESOCT_NODE_WORDS;
+    if (which == kernel::RESOCT_NODE_FLAGS || which == kernel::RESOCT_NODE_MINMAX) {
+      octree_changed_ = true;
+      break;
+    }
+  }
   if (send_full_ || node_deltas.full) {
     u.nodes_full = true;
     u.all_nodes = octree_->words();

@@ -156,8 +156,12 @@ void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t 
     const std::uint32_t count = D.count_x * D.count_y * D.count_z;
     const std::uint32_t child_shift = d < depth_limit ? depths[d + 1].child_shift : 0u;
     ok_here.assign(count, 0u);
+    // Only a depth whose last nodes along an axis start past the volume has nodes outside it.
+    const bool some_outside = std::uint64_t(D.count_x - 1u) * D.node_extent_x >= extent.x ||
+                              std::uint64_t(D.count_y - 1u) * D.node_extent_y >= extent.y ||
+                              std::uint64_t(D.count_z - 1u) * D.node_extent_z >= extent.z;
     for (std::uint32_t local = 0; local < count; ++local) {
-      if (outside_volume(D, local, extent)) {
+      if (some_outside && outside_volume(D, local, extent)) {
         ok_here[local] = shown;
         continue;
       }
