@@ -109,7 +109,7 @@ void block_metas(const Box3& box, std::span<const std::byte> voxels, const Value
             if (std::isnan(d)) continue;
             m.occupancy |= occupancy_bit(d, r);
           } else {
-            m.occupancy |= lut[std::size_t(v)];
+            m.occupancy |= lut.empty() ? occupancy_bit(d, r) : lut[std::size_t(v)];
           }
           m.min = std::min(m.min, d);
           m.max = std::max(m.max, d);
@@ -205,9 +205,13 @@ std::vector<std::pair<double, double>> scan_finite_minmax(const VolumeDesc& desc
 
 void fill_metadata(const VolumeDesc& desc, const LevelBoxReader& level0, MetadataPyramid& pyramid,
                    std::uint32_t threads) {
-  std::vector<std::vector<std::uint32_t>> luts;
-  for (std::uint32_t c = 0; c < desc.channels; ++c) {
-    luts.push_back(occupancy_lut(desc.type, desc.range(c)));
+  // A table pays only for channels with more voxels than it has entries (65536 for u16): a small
+  // file computes each voxel's bit instead of filling 256 KiB per channel.
+  const std::uint64_t voxels = desc.extent.x * desc.extent.y * desc.extent.z;
+  const std::uint64_t entries = desc.type == VoxelType::u8 ? 256u : 65536u;
+  std::vector<std::vector<std::uint32_t>> luts(desc.channels);
+  for (std::uint32_t c = 0; c < desc.channels && voxels >= entries; ++c) {
+    luts[c] = occupancy_lut(desc.type, desc.range(c));
   }
   for_each_tile(desc, level0, tile_edge(pyramid.block_size()), threads,
                 [&](const Box3& box, std::uint32_t c, std::span<const std::byte> v) {

@@ -21,7 +21,7 @@ std::vector<std::uint32_t> occupancy_lut(VoxelType t, const ValueRange& r);
 
 /// Widens out[i] by the voxels (dense, x fastest) of `box`, for every metadata block of edge
 /// `block` that the box touches (x fastest over the block range of the box). `lut` is
-/// occupancy_lut(t, r).
+/// occupancy_lut(t, r), or empty to compute every voxel's bit.
 void block_metadata(VoxelType t, const Box3& box, std::span<const std::byte> voxels,
                     const ValueRange& r, const std::vector<std::uint32_t>& lut, std::uint32_t block,
                     std::span<RegionMeta> out);
