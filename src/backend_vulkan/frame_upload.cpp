@@ -168,10 +168,7 @@ void VulkanBackend::Impl::upload_tables(const FrameTables& tables) {
          "step-level LUTs");
   if (buf[b_step_luts].buffer != step_luts_before) step_luts_on_device = 0;
   // One word per node whether or not the tables have bits: the kernel reads any node's word.
-  const kernel::ResoctDepthInfo& last_depth = tables.depths.back();
-  const std::size_t node_count =
-      std::size_t(last_depth.first_node) +
-      std::size_t(last_depth.count_x) * last_depth.count_y * last_depth.count_z;
+  const auto node_count = std::size_t(octree_node_count(tables.depths));
   const VkBuffer visible_before = buf[b_visible_subtrees].buffer;
   ensure(b_visible_subtrees, std::max<std::size_t>(node_count, 1) * sizeof(std::uint32_t),
          "visible subtrees");

@@ -174,6 +174,10 @@ struct FrameResult {
   BackendStats stats;
 };
 
+/// The nodes of the octree a depth table describes (FrameTables::depths; 0 for an empty table):
+/// the size of per-node arrays such as FrameTables::visible_subtrees.
+std::uint64_t octree_node_count(std::span<const kernel::ResoctDepthInfo> depths) noexcept;
+
 /// Checks that per-frame tables are consistent with themselves and with the configured sizes, so
 /// that a backend never indexes outside its arrays. Throws Error(invalid_argument) naming
 /// "tables". Every backend calls it at the start of render().

@@ -54,4 +54,60 @@ void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t 
 /// FrameTables::visible_subtrees_version; for other modes clears them (version 0).
 void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables);
 
+/// What VisibleSubtreeBuilder::update() did.
+struct VisibleSubtreeUpdate {
+  std::uint64_t recomputed = 0;     ///< nodes whose mask and word were computed again
+  std::uint64_t words_changed = 0;  ///< of those, nodes whose word changed
+};
+
+/// build_visible_subtrees kept up to date across frames. Beside the bits it keeps, per node, the
+/// entries whose whole subtree (down to the depth limit) has metadata and is shown. When only some
+/// records change (node answers and brick metadata arriving while a view loads), update()
+/// recomputes those nodes and the ancestors whose mask changes, instead of every node above the
+/// depth limit (millions on a 2048³ volume with 16³ leaves).
+class VisibleSubtreeBuilder {
+ public:
+  /// build_visible_subtrees into `out`, remembering the parameters and the per-node masks.
+  void build(std::span<const std::uint32_t> words, std::uint32_t node_slots,
+             std::span<const kernel::ResoctDepthInfo> depths,
+             std::span<const kernel::ResoctSlotInfo> slots, glm::uvec3 extent,
+             std::uint32_t start_depth, std::uint32_t depth_limit, std::vector<std::uint32_t>& out);
+
+  /// After the records of `nodes` (flat node indices, in any order, repeats allowed) changed in
+  /// `words`: brings `out`, as the last build() or update() left it, to what build() with the
+  /// same parameters would give now. Throws Error(invalid_argument) naming "octree" before any
+  /// build(), or when `words` or `out` do not fit the built tree, and "nodes" for an index past it.
+  VisibleSubtreeUpdate update(std::span<const std::uint32_t> words,
+                              std::span<const std::uint32_t> nodes,
+                              std::vector<std::uint32_t>& out);
+
+  /// build() for residency-mode tables over the octree a backend holds, with `depth_limit` from
+  /// deepest_traversal_depth(); a new FrameTables::visible_subtrees_version.
+  void build(const ResidencyOctree& octree, FrameTables& tables, std::uint32_t depth_limit);
+  /// update() of tables.visible_subtrees after the records of `nodes` changed; a new version
+  /// when any word changed.
+  VisibleSubtreeUpdate update(const ResidencyOctree& octree, std::span<const std::uint32_t> nodes,
+                              FrameTables& tables);
+
+ private:
+  struct NodeResult {
+    std::uint32_t ok;    // entries whose subtree, this node included, has metadata and is shown
+    std::uint32_t bits;  // the node's word
+  };
+  NodeResult compute(std::span<const std::uint32_t> words, std::uint32_t depth,
+                     std::uint32_t local) const;
+
+  std::uint32_t node_slots_ = 0;
+  std::vector<kernel::ResoctDepthInfo> depths_;
+  std::vector<kernel::ResoctSlotInfo> slots_;  // the first RESOCT_MAX_SLOTS entries
+  glm::uvec3 extent_{0};
+  std::uint32_t start_depth_ = 0;
+  std::uint32_t depth_limit_ = 0;
+  std::uint32_t shown_ = 0;                 // entries whose transfer function shows anything
+  std::vector<std::uint8_t> some_outside_;  // per depth: whether any node lies outside the volume
+  std::vector<std::uint32_t> ok_;           // per node at depths [start, limit]: NodeResult::ok
+  std::uint64_t nodes_ = 0;                 // nodes of the tree (0: not built)
+  std::vector<std::vector<std::uint32_t>> pending_;  // update(): nodes to recompute, per depth
+};
+
 }  // namespace resoct

@@ -9,6 +9,12 @@
 
 namespace resoct {
 
+std::uint64_t octree_node_count(std::span<const kernel::ResoctDepthInfo> depths) noexcept {
+  if (depths.empty()) return 0;
+  const kernel::ResoctDepthInfo& last = depths.back();
+  return std::uint64_t(last.first_node) + std::uint64_t(last.count_x) * last.count_y * last.count_z;
+}
+
 void check_page_table_config(const BackendConfig& config) {
   if (config.page_pool_blocks == 0 ||
       config.page_pool_blocks > kernel::RESOCT_REQUEST_MAX_POOL_BLOCKS) {
@@ -67,10 +73,7 @@ void check_frame_tables(const FrameTables& t, const BackendConfig& config) {
     fail("octree is smaller than the depth table");
   }
   // One word per node of the depth table, or none.
-  const std::uint64_t nodes =
-      std::uint64_t(t.depths.back().first_node) +
-      std::uint64_t(t.depths.back().count_x) * t.depths.back().count_y * t.depths.back().count_z;
-  if (!t.visible_subtrees.empty() && t.visible_subtrees.size() != nodes) {
+  if (!t.visible_subtrees.empty() && t.visible_subtrees.size() != octree_node_count(t.depths)) {
     fail("visible_subtrees size differs from the depth table's node count");
   }
   if (glm::uvec3(f.padded_x, f.padded_y, f.padded_z) != config.padded_brick) {

@@ -268,12 +268,12 @@ void Renderer::Impl::send_update(FrameStats& stats) {
   const OctreeDeltas node_deltas = octree_->take_deltas();
   // The visible-subtree bits read the records' flags and ranges only: bricks arriving change the
   // residency words every frame of a load, which leaves the bits as they are.
-  if (send_full_ || node_deltas.full) octree_changed_ = true;
+  if (send_full_ || node_deltas.full) octree_rebuilt_ = true;
+  const std::uint32_t record_words = kernel::RESOCT_NODE_WORDS * octree_->slot_count();
   for (const OctreeWordDelta& d : node_deltas.words) {
     const std::uint32_t which = d.index % kernel::RESOCT_NODE_WORDS;
     if (which == kernel::RESOCT_NODE_FLAGS || which == kernel::RESOCT_NODE_MINMAX) {
-      octree_changed_ = true;
-      break;
+      changed_nodes_.push_back(d.index / record_words);
     }
   }
   if (send_full_ || node_deltas.full) {
@@ -455,10 +455,11 @@ const FrameTables& Renderer::Impl::frame_tables(const Scene& scene, const FrameJ
 void Renderer::Impl::update_visible_subtrees() {
   if (options_.mode != RenderMode::residency) {
     build_visible_subtrees(*octree_, tables_);  // clears them
+    changed_nodes_.clear();
     return;
   }
-  // Rebuilt only when the octree's words or what the bits are computed from changed: with a
-  // still scene and a converged cache, never.
+  // Rebuilt only when what the bits are computed from changed besides the records, updated along
+  // the changed records' paths: with a still scene and a converged cache, neither.
   VisibleSubtreesKey key;
   key.depth_limit =
       deepest_traversal_depth(tables_.frame, tables_.levels, tables_.depths, tables_.slots);
@@ -467,11 +468,14 @@ void Renderer::Impl::update_visible_subtrees() {
   for (const kernel::ResoctSlotInfo& s : tables_.slots) {
     key.entries.insert(key.entries.end(), {s.slot, s.vis_bins, s.vis_lo16, s.vis_hi16});
   }
-  if (octree_changed_ || key != visible_subtrees_key_ || tables_.visible_subtrees_version == 0) {
-    build_visible_subtrees(*octree_, tables_);
+  if (octree_rebuilt_ || key != visible_subtrees_key_ || tables_.visible_subtrees_version == 0) {
+    visible_subtrees_.build(*octree_, tables_, key.depth_limit);
     visible_subtrees_key_ = std::move(key);
-    octree_changed_ = false;
+    octree_rebuilt_ = false;
+  } else if (!changed_nodes_.empty()) {
+    visible_subtrees_.update(*octree_, changed_nodes_, tables_);
   }
+  changed_nodes_.clear();
 }
 
 FrameReport Renderer::render_frame(const Scene& scene) {

@@ -22,6 +22,7 @@
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/render/frame_tables.hpp"
 #include "resoct/render/renderer.hpp"
+#include "resoct/render/visible_subtrees.hpp"
 
 namespace resoct {
 
@@ -124,7 +125,8 @@ struct Renderer::Impl {
   std::vector<BrickUpload> uploads_;
   FrameTables tables_;
   // What tables_.visible_subtrees was built from besides the octree's words: rebuilt when these
-  // differ or the octree changed (octree_changed_, set by send_update).
+  // differ or the whole octree was sent (octree_rebuilt_, set by send_update), updated along the
+  // paths of records whose flags or range changed (changed_nodes_).
   struct VisibleSubtreesKey {
     std::uint32_t depth_limit = 0;
     std::uint32_t start_depth = 0;
@@ -132,7 +134,9 @@ struct Renderer::Impl {
     bool operator==(const VisibleSubtreesKey&) const = default;
   };
   VisibleSubtreesKey visible_subtrees_key_;
-  bool octree_changed_ = true;
+  VisibleSubtreeBuilder visible_subtrees_;
+  bool octree_rebuilt_ = true;
+  std::vector<std::uint32_t> changed_nodes_;
   FrameResult result_;
 };
 

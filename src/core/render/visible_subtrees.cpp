@@ -120,71 +120,8 @@ void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t 
                             std::span<const k::ResoctSlotInfo> slots, glm::uvec3 extent,
                             std::uint32_t start_depth, std::uint32_t depth_limit,
                             std::vector<std::uint32_t>& out) {
-  out.clear();
-  if (depths.empty()) return;
-  const k::ResoctDepthInfo& last = depths.back();
-  const std::uint64_t nodes =
-      std::uint64_t(last.first_node) + std::uint64_t(last.count_x) * last.count_y * last.count_z;
-  if (words.size() < nodes * node_slots * k::RESOCT_NODE_WORDS) {
-    throw invalid_parameter("octree", std::to_string(words.size()) + " words for " +
-                                          std::to_string(nodes) + " nodes of " +
-                                          std::to_string(node_slots) + " slots");
-  }
-  const std::uint32_t entries =
-      std::min<std::uint32_t>(std::uint32_t(slots.size()), k::RESOCT_MAX_SLOTS);
-  std::uint32_t shown = 0;  // entries whose transfer function shows anything
-  for (std::uint32_t i = 0; i < entries; ++i) {
-    if (slots[i].slot >= node_slots) {
-      throw invalid_parameter("slots", "entry " + std::to_string(i) + " names slot " +
-                                           std::to_string(slots[i].slot) + " of " +
-                                           std::to_string(node_slots));
-    }
-    if (slots[i].vis_bins != 0u) shown |= 1u << i;
-  }
-  out.assign(std::size_t(nodes), 0u);
-  depth_limit = std::min<std::uint32_t>(depth_limit, std::uint32_t(depths.size()) - 1);
-  if (shown == 0u || depth_limit <= start_depth) return;
-
-  // Bottom-up from the depth limit: `ok` holds, per node of the depth below, the entries for
-  // which that node and its subtree (down to the limit) have metadata and are shown; a node's bit
-  // additionally needs a record that is not homogeneous. The limit's own nodes are checked but
-  // their children are not: no ray descends past them.
-  std::vector<std::uint32_t> ok_below;
-  std::vector<std::uint32_t> ok_here;
-  for (std::uint32_t d = depth_limit + 1; d-- > start_depth;) {
-    const k::ResoctDepthInfo& D = depths[d];
-    const std::uint32_t count = D.count_x * D.count_y * D.count_z;
-    const std::uint32_t child_shift = d < depth_limit ? depths[d + 1].child_shift : 0u;
-    ok_here.assign(count, 0u);
-    // Only a depth whose last nodes along an axis start past the volume has nodes outside it.
-    const bool some_outside = std::uint64_t(D.count_x - 1u) * D.node_extent_x >= extent.x ||
-                              std::uint64_t(D.count_y - 1u) * D.node_extent_y >= extent.y ||
-                              std::uint64_t(D.count_z - 1u) * D.node_extent_z >= extent.z;
-    for (std::uint32_t local = 0; local < count; ++local) {
-      if (some_outside && outside_volume(D, local, extent)) {
-        ok_here[local] = shown;
-        continue;
-      }
-      std::uint32_t ok = shown;
-      if (d < depth_limit) {
-        const std::uint32_t first = local << child_shift;
-        for (std::uint32_t c = 0; c < (1u << child_shift); ++c) ok &= ok_below[first + c];
-      }
-      std::uint32_t bits = 0;
-      for (std::uint32_t pending = ok; pending != 0u; pending &= pending - 1u) {
-        const std::uint32_t i = std::uint32_t(std::countr_zero(pending));
-        bool homogeneous = false;
-        if (!record_shown(words, D.first_node + local, slots[i], node_slots, homogeneous)) {
-          ok &= ~(1u << i);
-        } else if (!homogeneous) {
-          bits |= 1u << i;
-        }
-      }
-      ok_here[local] = ok;
-      if (d < depth_limit) out[D.first_node + local] = bits;
-    }
-    std::swap(ok_below, ok_here);
-  }
+  VisibleSubtreeBuilder().build(words, node_slots, depths, slots, extent, start_depth, depth_limit,
+                                out);
 }
 
 void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables) {
@@ -193,15 +130,157 @@ void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables) 
     tables.visible_subtrees_version = 0;
     return;
   }
-  build_visible_subtrees(
-      octree.words(), tables.frame.node_slot_count, tables.depths, tables.slots,
-      glm::uvec3(tables.frame.extent_x, tables.frame.extent_y, tables.frame.extent_z),
-      tables.frame.start_depth,
-      deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots),
-      tables.visible_subtrees);
-  // A process-wide counter: two producers never hand one backend equal versions of different bits.
-  static std::atomic<std::uint64_t> next_version{1};
-  tables.visible_subtrees_version = next_version.fetch_add(1, std::memory_order_relaxed);
+  VisibleSubtreeBuilder().build(
+      octree, tables,
+      deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots));
+}
+
+// A node's mask and word from its record and its children's masks (the children's first, when
+// the node is above the depth limit). The limit's own nodes are checked but their children are
+// not: no ray descends past them, and they get no word.
+VisibleSubtreeBuilder::NodeResult VisibleSubtreeBuilder::compute(
+    std::span<const std::uint32_t> words, std::uint32_t depth, std::uint32_t local) const {
+  const k::ResoctDepthInfo& D = depths_[depth];
+  if (some_outside_[depth] != 0u && outside_volume(D, local, extent_)) return {shown_, 0u};
+  std::uint32_t ok = shown_;
+  if (depth < depth_limit_) {
+    const k::ResoctDepthInfo& below = depths_[depth + 1];
+    const std::uint32_t first = below.first_node + (local << below.child_shift);
+    for (std::uint32_t c = 0; c < (1u << below.child_shift); ++c) ok &= ok_[first + c];
+  }
+  std::uint32_t bits = 0;
+  for (std::uint32_t pending = ok; pending != 0u; pending &= pending - 1u) {
+    const std::uint32_t i = std::uint32_t(std::countr_zero(pending));
+    bool homogeneous = false;
+    if (!record_shown(words, D.first_node + local, slots_[i], node_slots_, homogeneous)) {
+      ok &= ~(1u << i);
+    } else if (!homogeneous) {
+      bits |= 1u << i;
+    }
+  }
+  return {ok, depth < depth_limit_ ? bits : 0u};
+}
+
+void VisibleSubtreeBuilder::build(std::span<const std::uint32_t> words, std::uint32_t node_slots,
+                                  std::span<const k::ResoctDepthInfo> depths,
+                                  std::span<const k::ResoctSlotInfo> slots, glm::uvec3 extent,
+                                  std::uint32_t start_depth, std::uint32_t depth_limit,
+                                  std::vector<std::uint32_t>& out) {
+  nodes_ = 0;
+  out.clear();
+  if (depths.empty()) return;
+  const std::uint64_t nodes = octree_node_count(depths);
+  if (words.size() < nodes * node_slots * k::RESOCT_NODE_WORDS) {
+    throw invalid_parameter("octree", std::to_string(words.size()) + " words for " +
+                                          std::to_string(nodes) + " nodes of " +
+                                          std::to_string(node_slots) + " slots");
+  }
+  const std::uint32_t entries =
+      std::min<std::uint32_t>(std::uint32_t(slots.size()), k::RESOCT_MAX_SLOTS);
+  shown_ = 0;
+  for (std::uint32_t i = 0; i < entries; ++i) {
+    if (slots[i].slot >= node_slots) {
+      throw invalid_parameter("slots", "entry " + std::to_string(i) + " names slot " +
+                                           std::to_string(slots[i].slot) + " of " +
+                                           std::to_string(node_slots));
+    }
+    if (slots[i].vis_bins != 0u) shown_ |= 1u << i;
+  }
+  node_slots_ = node_slots;
+  depths_.assign(depths.begin(), depths.end());
+  slots_.assign(slots.begin(), slots.begin() + entries);
+  extent_ = extent;
+  start_depth_ = start_depth;
+  depth_limit_ = std::min<std::uint32_t>(depth_limit, std::uint32_t(depths.size()) - 1);
+  // Only a depth whose last nodes along an axis start past the volume has nodes outside it.
+  some_outside_.assign(depths.size(), 0u);
+  for (std::size_t d = 0; d < depths.size(); ++d) {
+    const k::ResoctDepthInfo& D = depths[d];
+    some_outside_[d] = std::uint64_t(D.count_x - 1u) * D.node_extent_x >= extent.x ||
+                       std::uint64_t(D.count_y - 1u) * D.node_extent_y >= extent.y ||
+                       std::uint64_t(D.count_z - 1u) * D.node_extent_z >= extent.z;
+  }
+  ok_.assign(std::size_t(nodes), 0u);
+  out.assign(std::size_t(nodes), 0u);
+  nodes_ = nodes;
+  if (shown_ == 0u || depth_limit_ <= start_depth_) return;
+  // Bottom-up from the depth limit, so that every node finds its children's masks.
+  for (std::uint32_t d = depth_limit_ + 1; d-- > start_depth_;) {
+    const k::ResoctDepthInfo& D = depths_[d];
+    const std::uint32_t count = D.count_x * D.count_y * D.count_z;
+    for (std::uint32_t local = 0; local < count; ++local) {
+      const NodeResult r = compute(words, d, local);
+      ok_[D.first_node + local] = r.ok;
+      out[D.first_node + local] = r.bits;
+    }
+  }
+}
+
+VisibleSubtreeUpdate VisibleSubtreeBuilder::update(std::span<const std::uint32_t> words,
+                                                   std::span<const std::uint32_t> nodes,
+                                                   std::vector<std::uint32_t>& out) {
+  if (nodes_ == 0 || out.size() != nodes_ ||
+      words.size() < nodes_ * node_slots_ * k::RESOCT_NODE_WORDS) {
+    throw invalid_parameter("octree", "update of visible subtrees without a build of this tree");
+  }
+  VisibleSubtreeUpdate result;
+  if (shown_ == 0u || depth_limit_ <= start_depth_) return result;
+  pending_.resize(depths_.size());
+  for (std::vector<std::uint32_t>& p : pending_) p.clear();
+  for (const std::uint32_t node : nodes) {
+    if (node >= nodes_) {
+      throw invalid_parameter("nodes",
+                              "node " + std::to_string(node) + " of " + std::to_string(nodes_));
+    }
+    // The depth holding the node: the last one starting at or before it.
+    std::uint32_t d = std::uint32_t(depths_.size()) - 1;
+    while (depths_[d].first_node > node) --d;
+    // Records below the limit are never read, and no node above the start depth has a word.
+    if (d >= start_depth_ && d <= depth_limit_) pending_[d].push_back(node - depths_[d].first_node);
+  }
+  // Deepest first: a node is recomputed after its changed children, and its parent is queued
+  // only when its mask changed (a word alone changing stops there).
+  for (std::uint32_t d = depth_limit_ + 1; d-- > start_depth_;) {
+    std::vector<std::uint32_t>& locals = pending_[d];
+    std::sort(locals.begin(), locals.end());
+    locals.erase(std::unique(locals.begin(), locals.end()), locals.end());
+    const k::ResoctDepthInfo& D = depths_[d];
+    for (const std::uint32_t local : locals) {
+      const NodeResult r = compute(words, d, local);
+      ++result.recomputed;
+      if (out[D.first_node + local] != r.bits) {
+        out[D.first_node + local] = r.bits;
+        ++result.words_changed;
+      }
+      if (r.ok != ok_[D.first_node + local]) {
+        ok_[D.first_node + local] = r.ok;
+        if (d > start_depth_) pending_[d - 1].push_back(local >> D.child_shift);
+      }
+    }
+  }
+  return result;
+}
+
+// A process-wide counter: two producers never hand one backend equal versions of different bits.
+static std::uint64_t next_visible_subtrees_version() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
+void VisibleSubtreeBuilder::build(const ResidencyOctree& octree, FrameTables& tables,
+                                  std::uint32_t depth_limit) {
+  build(octree.words(), tables.frame.node_slot_count, tables.depths, tables.slots,
+        glm::uvec3(tables.frame.extent_x, tables.frame.extent_y, tables.frame.extent_z),
+        tables.frame.start_depth, depth_limit, tables.visible_subtrees);
+  tables.visible_subtrees_version = next_visible_subtrees_version();
+}
+
+VisibleSubtreeUpdate VisibleSubtreeBuilder::update(const ResidencyOctree& octree,
+                                                   std::span<const std::uint32_t> nodes,
+                                                   FrameTables& tables) {
+  const VisibleSubtreeUpdate result = update(octree.words(), nodes, tables.visible_subtrees);
+  if (result.words_changed != 0) tables.visible_subtrees_version = next_visible_subtrees_version();
+  return result;
 }
 
 }  // namespace resoct

@@ -1,6 +1,9 @@
 // The frame's visible-subtree bits (render/visible_subtrees.hpp) on a hand-made octree of three
 // depths (1, 8 and 64 nodes; one record slot), against what the residency descent would find:
 // a bit only where no node at or below it, down to the depth limit, is hidden or unknown.
+#include <cstdint>
+#include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -172,6 +175,103 @@ TEST(VisibleSubtreesLimits, TheDepthLimitFollowsTheShortestStepAndTheFinestLevel
   s.finest_level = 0;
   f.step_scale = 10.0f;  // steps of 10 voxels: nodes of 16 are the smallest that long
   EXPECT_EQ(deepest_traversal_depth(f, levels, depths(), std::vector{s}), 1u);
+}
+
+// The incremental update (VisibleSubtreeBuilder::update) against a full build of the same words:
+// two record slots, two entries, nodes outside the volume (extent 24 of the 32 the counts span),
+// random records changed a few nodes at a time, for every start depth and depth limit.
+TEST(VisibleSubtreeUpdates, GiveWhatAFullBuildOfTheChangedRecordsGives) {
+  constexpr std::uint32_t kSlots = 2;
+  const std::vector<k::ResoctSlotInfo> entries = [] {
+    std::vector<k::ResoctSlotInfo> e{shows_from(0.1), shows_from(0.4)};
+    e[1].slot = 1;
+    return e;
+  }();
+  const glm::uvec3 extent(32, 24, 32);
+  std::mt19937 rng(20261128);
+  auto draw = [&rng](std::uint32_t n) { return std::uint32_t(rng() % n); };
+  for (std::uint32_t start = 0; start < 2; ++start) {
+    for (std::uint32_t limit = start + 1; limit < 3; ++limit) {
+      std::vector<std::uint32_t> words(kNodes * kSlots * k::RESOCT_NODE_WORDS, 0u);
+      auto set_random = [&](std::uint32_t node) {
+        for (std::uint32_t s = 0; s < kSlots; ++s) {
+          const std::uint32_t base = k::resoct_node_base(node, s, kSlots);
+          // Mostly shown ranges, so that bits exist for changes to clear; some hidden, unknown
+          // and homogeneous ones.
+          const std::uint32_t kind = draw(24);
+          const std::uint32_t lo = kind == 0   ? draw(6000)
+                                   : kind == 1 ? 30000u
+                                               : 20000u + draw(20000);
+          const std::uint32_t hi = kind == 0 ? lo + draw(100) : kind == 1 ? lo : lo + draw(20000);
+          words[base + k::RESOCT_NODE_FLAGS] = k::resoct_node_make_flags(
+              kind == 2 ? k::RESOCT_NODE_INVALID : k::RESOCT_NODE_VALID, 0u);
+          words[base + k::RESOCT_NODE_MINMAX] = k::resoct_node_pack_minmax(lo, hi);
+        }
+      };
+      for (std::uint32_t n = 0; n < kNodes; ++n) set_random(n);
+      VisibleSubtreeBuilder builder;
+      std::vector<std::uint32_t> kept;
+      builder.build(words, kSlots, depths(), entries, extent, start, limit, kept);
+      std::uint64_t changed_words = 0;
+      for (int round = 0; round < 300; ++round) {
+        std::vector<std::uint32_t> changed(1 + draw(4));
+        for (std::uint32_t& n : changed) {
+          n = draw(kNodes);
+          set_random(n);
+        }
+        changed.push_back(changed.front());  // repeats are allowed
+        changed_words += builder.update(words, changed, kept).words_changed;
+        std::vector<std::uint32_t> fresh;
+        build_visible_subtrees(words, kSlots, depths(), entries, extent, start, limit, fresh);
+        ASSERT_EQ(kept, fresh) << "start " << start << ", limit " << limit << ", round " << round;
+      }
+      EXPECT_GE(changed_words, 10u) << "the rounds must change bits for the check to mean anything";
+    }
+  }
+}
+
+// An update walks up from a changed record only while the subtree masks change.
+TEST(VisibleSubtreeUpdates, RecomputeOnlyThePathsWhoseMasksChange) {
+  Tree t;
+  VisibleSubtreeBuilder builder;
+  std::vector<std::uint32_t> bits;
+  builder.build(t.words, 1, depths(), std::vector{shows_from(0.1)}, glm::uvec3(32u), 0, 2, bits);
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.05);  // now hidden: its parent and the root lose bits
+  const std::uint32_t leaf[] = {kLeaf};
+  const VisibleSubtreeUpdate hidden = builder.update(t.words, leaf, bits);
+  EXPECT_EQ(hidden.recomputed, 3u);
+  EXPECT_EQ(hidden.words_changed, 2u);
+  EXPECT_EQ(bits[kLeafParent], 0u);
+  EXPECT_EQ(bits[0], 0u);
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.2, 0.6);  // shown again, with another range
+  EXPECT_EQ(builder.update(t.words, leaf, bits).words_changed, 2u);
+  EXPECT_EQ(bits, t.bits({shows_from(0.1)}));
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.3, 0.7);  // still shown: the leaf alone is recomputed
+  const VisibleSubtreeUpdate same = builder.update(t.words, leaf, bits);
+  EXPECT_EQ(same.recomputed, 1u);
+  EXPECT_EQ(same.words_changed, 0u);
+}
+
+TEST(VisibleSubtreeUpdates, WithoutABuildOrPastTheTreeAreRejected) {
+  Tree t;
+  VisibleSubtreeBuilder builder;
+  std::vector<std::uint32_t> bits(kNodes, 0u);
+  const std::uint32_t leaf[] = {kLeaf};
+  auto message = [&](const std::uint32_t* nodes) {
+    try {
+      builder.update(t.words, std::span(nodes, 1), bits);
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(leaf).find("octree"), std::string::npos) << "no build yet";
+  builder.build(t.words, 1, depths(), std::vector{shows_from(0.1)}, glm::uvec3(32u), 0, 2, bits);
+  const std::uint32_t past[] = {kNodes};
+  EXPECT_NE(message(past).find("nodes"), std::string::npos);
+  std::vector<std::uint32_t> other(kNodes - 1, 0u);
+  EXPECT_THROW(builder.update(t.words, leaf, other), Error) << "bits of another tree";
 }
 
 }  // namespace
