@@ -57,6 +57,16 @@ TEST(FuzzRegressions, TiffPageAnnouncingMorePixelsThanTheFileHoldsIsCorrupt) {
   EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt, path);
 }
 
+TEST(FuzzRegressions, TiffTilesAnnouncingMorePixelsThanTheFileHoldsAreCorrupt) {
+  // 283 bytes whose 9x68 page (within the budget) announces 9x1224736773 tiles of u16:
+  // open_tiff_stack allocated and cleared a 22 GB tile buffer before libtiff failed to read the
+  // tile (libFuzzer stopped it at its 2 GB memory limit; a release build took six minutes).
+  const std::string path = regression("tiff_file", "tiles-9x1224736773-in-283-bytes.tif");
+  EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt,
+                      "9x1224736773 tiles cannot be held");
+  EXPECT_RESOCT_ERROR(open_tiff_stack(path), ErrorCode::corrupt, path);
+}
+
 TEST(FuzzRegressions, SceneNumberBeyondDoubleRangeIsMalformedJson) {
   // nlohmann::json reports "1e3080" as out_of_range, not parse_error; parse_scene let that
   // escape as a foreign exception.
