@@ -15,7 +15,6 @@
 #include "resoct/engine/prefetch.hpp"
 #include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
-#include "resoct/render/visible_subtrees.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
@@ -266,16 +265,7 @@ void Renderer::Impl::send_update(FrameStats& stats) {
     stats.page_deltas = page_deltas.pool.size() + page_deltas.directory.size();
   }
   const OctreeDeltas node_deltas = octree_->take_deltas();
-  // The visible-subtree bits read the records' flags and ranges only: bricks arriving change the
-  // residency words every frame of a load, which leaves the bits as they are.
-  if (send_full_ || node_deltas.full) octree_rebuilt_ = true;
-  const std::uint32_t record_words = kernel::RESOCT_NODE_WORDS * octree_->slot_count();
-  for (const OctreeWordDelta& d : node_deltas.words) {
-    const std::uint32_t which = d.index % kernel::RESOCT_NODE_WORDS;
-    if (which == kernel::RESOCT_NODE_FLAGS || which == kernel::RESOCT_NODE_MINMAX) {
-      changed_nodes_.push_back(d.index / record_words);
-    }
-  }
+  visible_subtrees_.note_sent(node_deltas, send_full_ || node_deltas.full, octree_->slot_count());
   if (send_full_ || node_deltas.full) {
     u.nodes_full = true;
     u.all_nodes = octree_->words();
@@ -448,34 +438,8 @@ const FrameTables& Renderer::Impl::frame_tables(const Scene& scene, const FrameJ
   // transfer functions that changed are computed again (FrameTables::lut_sources).
   build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
   tables_.image_to_host = options_.output != FrameOutput::device;
-  update_visible_subtrees();
+  visible_subtrees_.refresh(*octree_, options_.mode, tables_);
   return tables_;
-}
-
-void Renderer::Impl::update_visible_subtrees() {
-  if (options_.mode != RenderMode::residency) {
-    build_visible_subtrees(*octree_, tables_);  // clears them
-    changed_nodes_.clear();
-    return;
-  }
-  // Rebuilt only when what the bits are computed from changed besides the records, updated along
-  // the changed records' paths: with a still scene and a converged cache, neither.
-  VisibleSubtreesKey key;
-  key.depth_limit =
-      deepest_traversal_depth(tables_.frame, tables_.levels, tables_.depths, tables_.slots);
-  key.start_depth = tables_.frame.start_depth;
-  key.entries.reserve(tables_.slots.size() * 4);
-  for (const kernel::ResoctSlotInfo& s : tables_.slots) {
-    key.entries.insert(key.entries.end(), {s.slot, s.vis_bins, s.vis_lo16, s.vis_hi16});
-  }
-  if (octree_rebuilt_ || key != visible_subtrees_key_ || tables_.visible_subtrees_version == 0) {
-    visible_subtrees_.build(*octree_, tables_, key.depth_limit);
-    visible_subtrees_key_ = std::move(key);
-    octree_rebuilt_ = false;
-  } else if (!changed_nodes_.empty()) {
-    visible_subtrees_.update(*octree_, changed_nodes_, tables_);
-  }
-  changed_nodes_.clear();
 }
 
 FrameReport Renderer::render_frame(const Scene& scene) {

@@ -22,7 +22,7 @@
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/render/frame_tables.hpp"
 #include "resoct/render/renderer.hpp"
-#include "resoct/render/visible_subtrees.hpp"
+#include "visible_subtree_tracker.hpp"
 
 namespace resoct {
 
@@ -65,8 +65,6 @@ struct Renderer::Impl {
   void render_frame(const Scene& scene, FrameReport& report, const FrameJitter& jitter);
 
   const FrameTables& frame_tables(const Scene& scene, const FrameJitter& jitter);
-  // Rebuilds tables_.visible_subtrees (residency mode) when the octree or its inputs changed.
-  void update_visible_subtrees();
   void take_pixels(FrameReport& report);
   void assign_channels(const Scene& scene);
   void switch_timepoint(std::uint32_t t);
@@ -124,19 +122,7 @@ struct Renderer::Impl {
   std::vector<std::shared_ptr<const HostBrick>> upload_data_;
   std::vector<BrickUpload> uploads_;
   FrameTables tables_;
-  // What tables_.visible_subtrees was built from besides the octree's words: rebuilt when these
-  // differ or the whole octree was sent (octree_rebuilt_, set by send_update), updated along the
-  // paths of records whose flags or range changed (changed_nodes_).
-  struct VisibleSubtreesKey {
-    std::uint32_t depth_limit = 0;
-    std::uint32_t start_depth = 0;
-    std::vector<std::uint32_t> entries;  // per slot-table entry: slot, vis_bins, vis_lo16, vis_hi16
-    bool operator==(const VisibleSubtreesKey&) const = default;
-  };
-  VisibleSubtreesKey visible_subtrees_key_;
-  VisibleSubtreeBuilder visible_subtrees_;
-  bool octree_rebuilt_ = true;
-  std::vector<std::uint32_t> changed_nodes_;
+  detail::VisibleSubtreeTracker visible_subtrees_;  // tables_.visible_subtrees kept current
   FrameResult result_;
 };
 

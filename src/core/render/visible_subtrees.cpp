@@ -82,6 +82,12 @@ bool outside_volume(const k::ResoctDepthInfo& D, std::uint32_t local, glm::uvec3
          std::uint64_t(extract_bits(local, D.axis_bits_z)) * D.node_extent_z >= extent.z;
 }
 
+// A process-wide counter: two producers never hand one backend equal versions of different bits.
+std::uint64_t next_visible_subtrees_version() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
+}
+
 }  // namespace
 
 std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
@@ -259,12 +265,6 @@ VisibleSubtreeUpdate VisibleSubtreeBuilder::update(std::span<const std::uint32_t
     }
   }
   return result;
-}
-
-// A process-wide counter: two producers never hand one backend equal versions of different bits.
-static std::uint64_t next_visible_subtrees_version() {
-  static std::atomic<std::uint64_t> next{1};
-  return next.fetch_add(1, std::memory_order_relaxed);
 }
 
 void VisibleSubtreeBuilder::build(const ResidencyOctree& octree, FrameTables& tables,

@@ -1,0 +1,45 @@
+#pragma once
+// Internal to resoct::core: when the Renderer's visible-subtree bits (FrameTables::
+// visible_subtrees, render/visible_subtrees.hpp) must be rebuilt, updated or left alone.
+//
+// The bits are computed from the octree's records and from what the frame's tables say about
+// them (the transfer functions' visible ranges, the start depth and the deepest depth a ray
+// descends to). A still scene whose cache has converged changes neither, so a steady frame does
+// no work here; node answers and brick metadata arriving while a view loads change some records,
+// and only the paths above those are computed again (VisibleSubtreeBuilder::update).
+#include <cstdint>
+#include <vector>
+
+#include "resoct/backend/backend.hpp"
+#include "resoct/engine/residency_octree.hpp"
+#include "resoct/render/visible_subtrees.hpp"
+
+namespace resoct::detail {
+
+class VisibleSubtreeTracker {
+ public:
+  /// Records what this frame's update sends of the octree: `full` when the backend receives every
+  /// word (the bits are rebuilt), otherwise the word deltas, of which only the flags and the value
+  /// range of a record (RESOCT_NODE_FLAGS, RESOCT_NODE_MINMAX) matter to the bits. Bricks arriving
+  /// change the residency words every frame of a load and leave the bits as they are.
+  void note_sent(const OctreeDeltas& deltas, bool full, std::uint32_t node_slots);
+
+  /// Brings tables.visible_subtrees up to date with `octree` (the words as sent) after the rest of
+  /// `tables` was built for this frame: residency mode only; other modes get none (version 0).
+  void refresh(const ResidencyOctree& octree, RenderMode mode, FrameTables& tables);
+
+ private:
+  // What the bits were built from besides the octree's words.
+  struct Key {
+    std::uint32_t depth_limit = 0;
+    std::uint32_t start_depth = 0;
+    std::vector<std::uint32_t> entries;  // per slot-table entry: slot, vis_bins, vis_lo16, vis_hi16
+    bool operator==(const Key&) const = default;
+  };
+  Key key_;
+  VisibleSubtreeBuilder builder_;
+  bool rebuild_ = true;                      // the whole octree was sent since the last refresh
+  std::vector<std::uint32_t> changed_nodes_;  // nodes whose flags or range changed since then
+};
+
+}  // namespace resoct::detail
