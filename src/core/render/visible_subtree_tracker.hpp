@@ -38,7 +38,7 @@ class VisibleSubtreeTracker {
   };
   Key key_;
   VisibleSubtreeBuilder builder_;
-  bool rebuild_ = true;                      // the whole octree was sent since the last refresh
+  bool rebuild_ = true;                       // the whole octree was sent since the last refresh
   std::vector<std::uint32_t> changed_nodes_;  // nodes whose flags or range changed since then
 };
 
