@@ -89,8 +89,8 @@ template <class T>
   v8f v000, v100, v010, v110, v001, v101, v011, v111;
   if constexpr (sizeof(T) == 4) {
     // f32 would take eight gathers per packet, one per voxel of the footprint; scalar loads,
-    // lane by lane, measured about 5 % faster per frame on the sphere (bench/README.md, twelfth
-    // pass). The packed types read two voxels per gathered word, where gathers win.
+    // lane by lane, measured 1.4-5 % less CPU time per frame on the sphere (bench/README.md,
+    // twelfth pass). The packed types read two voxels per gathered word, where gathers win.
     const std::size_t dy = g.dy * sizeof(T), dz = g.dz * sizeof(T);
     for (int l = 0; l < 8; ++l) {
       const std::size_t o = std::size_t(i[l]);

@@ -20,13 +20,13 @@
 RESOCT_KERNEL_BEGIN
 
 /// Level-0 voxels per box unit as a vector.
-RESOCT_FN vec3 resoct_frame_voxels_per_box(ResoctFrame f) {
+RESOCT_FN vec3 resoct_frame_voxels_per_box(RESOCT_FRAME_IN f) {
   return vec3(f.voxels_per_box_x, f.voxels_per_box_y, f.voxels_per_box_z);
 }
 
 /// The ray of pixel (px, py): unit direction in box space, and its origin in voxel space split
 /// into an exact cell and a fraction in [0, 1).
-RESOCT_FN void resoct_camera_ray(ResoctFrame f, uint px, uint py, RESOCT_OUT(vec3) dir_box,
+RESOCT_FN void resoct_camera_ray(RESOCT_FRAME_IN f, uint px, uint py, RESOCT_OUT(vec3) dir_box,
                                  RESOCT_OUT(ivec3) origin_cell, RESOCT_OUT(vec3) origin_frac) {
   // Every operation here is precise and every quotient a product with a correctly rounded
   // reciprocal, so that a ray is the same float on every backend: a device compiler may fuse a
@@ -61,7 +61,7 @@ RESOCT_FN void resoct_camera_ray(ResoctFrame f, uint px, uint py, RESOCT_OUT(vec
 }
 
 /// View depth (distance along forward) of the point at parameter t of a camera ray.
-RESOCT_FN float resoct_view_depth(ResoctFrame f, vec3 dir_box, float t) {
+RESOCT_FN float resoct_view_depth(RESOCT_FRAME_IN f, vec3 dir_box, float t) {
   if (f.projection != RESOCT_PROJECTION_PERSPECTIVE) return 0.0f;
   return t * dot(dir_box, vec3(f.forward_x, f.forward_y, f.forward_z));
 }
@@ -94,7 +94,7 @@ RESOCT_FN void resoct_ray_position(ivec3 origin_cell, vec3 origin_frac, vec3 dir
 }
 
 /// Clamps a position into the volume [0, extent) (drift of a sample at the border by rounding).
-RESOCT_FN void resoct_clamp_position(ResoctFrame f, RESOCT_INOUT(ivec3) cell,
+RESOCT_FN void resoct_clamp_position(RESOCT_FRAME_IN f, RESOCT_INOUT(ivec3) cell,
                                      RESOCT_INOUT(vec3) frac) {
   ivec3 hi = ivec3(int(f.extent_x) - 1, int(f.extent_y) - 1, int(f.extent_z) - 1);
   if (cell.x < 0) {

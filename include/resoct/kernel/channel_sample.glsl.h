@@ -35,7 +35,7 @@ struct ResoctSampleParams {
   uint brick_z;
 };
 
-RESOCT_FN ResoctSampleParams resoct_sample_params(ResoctFrame f) {
+RESOCT_FN ResoctSampleParams resoct_sample_params(RESOCT_FRAME_IN f) {
   ResoctSampleParams p;
   p.level_count = f.level_count;
   p.node_slot_count = f.node_slot_count;

@@ -94,7 +94,7 @@ struct ResoctFxParams {
   uint max_iterations;
 };
 
-RESOCT_FN ResoctFxParams resoct_fx_params(ResoctFrame f, ResoctFxFrame e) {
+RESOCT_FN ResoctFxParams resoct_fx_params(RESOCT_FRAME_IN f, ResoctFxFrame e) {
   ResoctFxParams p;
   p.light_kind = e.light_kind;
   p.light_x = e.light_x;

@@ -99,7 +99,7 @@ RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, ve
 }
 
 /// The traversal depth of a primary ray with step dt.
-RESOCT_FN uint resoct_traversal_depth(ResoctFrame f, float dt) {
+RESOCT_FN uint resoct_traversal_depth(RESOCT_FRAME_IN f, float dt) {
   return resoct_traversal_depth_for(
       f.start_depth, f.depth_count,
       vec3(f.voxels_per_box_x, f.voxels_per_box_y, f.voxels_per_box_z), dt);

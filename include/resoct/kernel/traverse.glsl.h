@@ -75,7 +75,7 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
 /// Renders one pixel with the effects of RESOCT_EFFECTS (kernel/effects.glsl.h): the
 /// premultiplied colour over the background. `stats` receives the ray's counters. With mask 0
 /// every effect branch is compiled out.
-RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
+RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                                          RESOCT_OUT(ResoctRayStats) stats) {
   resoct_stats_clear(stats);
   vec4 background = vec4(f.background_r, f.background_g, f.background_b, f.background_a);
@@ -780,7 +780,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(ResoctFrame f, uint px, uint py,
 }
 
 /// Renders one pixel without effects (C++), or with the pipeline's RESOCT_EFFECTS (GLSL).
-RESOCT_FN vec4 resoct_render_pixel(ResoctFrame f, uint px, uint py,
+RESOCT_FN vec4 resoct_render_pixel(RESOCT_FRAME_IN f, uint px, uint py,
                                    RESOCT_OUT(ResoctRayStats) stats) {
   return RESOCT_FX_PLAIN(resoct_render_pixel_fx)(f, px, py, stats);
 }

@@ -1,5 +1,7 @@
 #include "visible_subtree_tracker.hpp"
 
+#include <utility>
+
 #include "resoct/kernel/octree_node.glsl.h"
 
 namespace resoct::detail {
@@ -28,17 +30,18 @@ void VisibleSubtreeTracker::refresh(const ResidencyOctree& octree, RenderMode mo
     changed_nodes_.clear();
     return;
   }
-  Key key;
+  // This frame's key is built in a kept buffer: a steady frame allocates nothing here.
+  Key& key = scratch_;
   key.depth_limit =
       deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots);
   key.start_depth = tables.frame.start_depth;
-  key.entries.reserve(tables.slots.size() * 4);
+  key.entries.clear();
   for (const kernel::ResoctSlotInfo& s : tables.slots) {
     key.entries.insert(key.entries.end(), {s.slot, s.vis_bins, s.vis_lo16, s.vis_hi16});
   }
   if (rebuild_ || key != key_ || tables.visible_subtrees_version == 0) {
     builder_.build(octree, tables, key.depth_limit);
-    key_ = std::move(key);
+    std::swap(key_, scratch_);
     rebuild_ = false;
   } else if (!changed_nodes_.empty()) {
     builder_.update(octree, changed_nodes_, tables);

@@ -37,6 +37,7 @@ class VisibleSubtreeTracker {
     bool operator==(const Key&) const = default;
   };
   Key key_;
+  Key scratch_;  // the key being compared, kept between frames for its capacity
   VisibleSubtreeBuilder builder_;
   bool rebuild_ = true;                       // the whole octree was sent since the last refresh
   std::vector<std::uint32_t> changed_nodes_;  // nodes whose flags or range changed since then
