@@ -66,7 +66,8 @@ inline int bitCount(uint v) {
 #define RESOCT_CONST(T, name, value) inline constexpr T name = value
 #define RESOCT_KERNEL_BEGIN namespace resoct::kernel {
 #define RESOCT_KERNEL_END }
-// Read-only frame parameter: by reference in C++ (no 400-byte copy per call), by value in GLSL.
+// Read-only frame parameter: by reference in C++ (no copy of the 520-byte record per call), by
+// value in GLSL.
 #define RESOCT_FRAME_IN const ResoctFrame&
 // Read-only record parameter: by reference in C++, by value in GLSL.
 #define RESOCT_IN(T) const T&
