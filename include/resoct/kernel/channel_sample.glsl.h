@@ -47,12 +47,12 @@ RESOCT_FN ResoctSampleParams resoct_sample_params(RESOCT_FRAME_IN f) {
   return p;
 }
 
-RESOCT_FN uvec3 resoct_frame_brick_size(ResoctSampleParams f) {
+RESOCT_FN uvec3 resoct_frame_brick_size(RESOCT_IN(ResoctSampleParams) f) {
   return uvec3(f.brick_x, f.brick_y, f.brick_z);
 }
 
 /// Levels a slot may use as a bitmask: [finest, coarsest].
-RESOCT_FN uint resoct_allowed_levels(ResoctSlotInfo s) {
+RESOCT_FN uint resoct_allowed_levels(RESOCT_IN(ResoctSlotInfo) s) {
   uint hi = s.coarsest_level >= 31u ? 0xFFFFFFFFu : ((2u << s.coarsest_level) - 1u);
   return hi & ~((1u << s.finest_level) - 1u);
 }
@@ -89,7 +89,7 @@ RESOCT_FN float resoct_box_entry_t(ivec3 cell, vec3 frac, vec3 inv_vox, ivec3 lo
 
 /// Whether an EMPTY page entry renders: a brick of zeros where the transfer function shows 0
 /// (ResoctSlotInfo.zero_visible). A brick without finite values never does.
-RESOCT_FN bool resoct_empty_page_shows(ResoctSlotInfo s, uint entry) {
+RESOCT_FN bool resoct_empty_page_shows(RESOCT_IN(ResoctSlotInfo) s, uint entry) {
   return s.zero_visible != 0u && resoct_page_payload(entry) == 0u;
 }
 
@@ -134,7 +134,7 @@ RESOCT_FN ResoctSource resoct_source_of(uint kind, float value) {
 }
 
 /// A constant source of slot `s`.
-RESOCT_FN ResoctSource resoct_source_value(ResoctSlotInfo s, float value) {
+RESOCT_FN ResoctSource resoct_source_value(RESOCT_IN(ResoctSlotInfo) s, float value) {
   ResoctSource src = resoct_source_of(RESOCT_CH_VALUE, value);
   src.tf_slot = s.slot;
   return src;
@@ -157,15 +157,16 @@ RESOCT_FN void resoct_box_clip(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi, i
 
 /// Clips [lo, hi) to the level-0 box of a brick of level L.
 RESOCT_FN void resoct_box_clip_brick(RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
-                                     ResoctLevelInfo L, uvec3 brick_size, uvec3 brick) {
+                                     RESOCT_IN(ResoctLevelInfo) L, uvec3 brick_size, uvec3 brick) {
   ivec3 blo = resoct_brick_lo0(L, brick_size, brick);
   resoct_box_clip(lo, hi, blo, blo + ivec3(resoct_brick_size0(L, brick_size)));
 }
 
 /// The source of a present (not UNMAPPED) page entry of `level`; marks a mapped brick's cache
 /// slot used (once per segment).
-RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint level,
-                                           ResoctLevelInfo L, uvec3 brick_size, uvec3 brick) {
+RESOCT_FN ResoctSource resoct_entry_source(RESOCT_IN(ResoctSlotInfo) s, uint entry, uint level,
+                                           RESOCT_IN(ResoctLevelInfo) L, uvec3 brick_size,
+                                           uvec3 brick) {
   uint state = resoct_page_state(entry);
   ResoctSource src = resoct_source_of(RESOCT_CH_NONE, 0.0f);
   if (state == RESOCT_PAGE_STATE_EMPTY) {
@@ -189,8 +190,9 @@ RESOCT_FN ResoctSource resoct_entry_source(ResoctSlotInfo s, uint entry, uint le
 
 /// The value of a source at a level-0 position inside its segment: RESOCT_CH_VALUE with `value`
 /// (a trilinear sample of a mapped brick through its halo, or the constant), else the kind.
-RESOCT_FN uint resoct_source_sample(ResoctSampleParams f, ResoctSource src, ivec3 cell, vec3 frac,
-                                    RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_source_sample(RESOCT_IN(ResoctSampleParams) f, RESOCT_IN(ResoctSource) src,
+                                    ivec3 cell, vec3 frac, RESOCT_OUT(float) value,
+                                    RESOCT_INOUT(ResoctRayStats) st) {
   value = src.value;
   if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
   st.brick_accesses = st.brick_accesses + 1u;
@@ -212,7 +214,7 @@ RESOCT_FN void resoct_source_along_ray(RESOCT_INOUT(ResoctSource) src, ivec3 ori
 }
 
 /// resoct_source_sample at ray parameter t, after resoct_source_along_ray.
-RESOCT_FN uint resoct_source_sample_t(ResoctSource src, float t, RESOCT_OUT(float) value,
+RESOCT_FN uint resoct_source_sample_t(RESOCT_IN(ResoctSource) src, float t, RESOCT_OUT(float) value,
                                       RESOCT_INOUT(ResoctRayStats) st) {
   value = src.value;
   if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return src.kind;
@@ -225,11 +227,11 @@ RESOCT_FN uint resoct_source_sample_t(ResoctSource src, float t, RESOCT_OUT(floa
 
 /// Requests the target brick of a missing sample (once per ray and slot while the key repeats)
 /// and, greedy, every coarser level's brick at the position up to the first present one.
-RESOCT_FN void resoct_request_missing(ResoctSampleParams f, ResoctSlotInfo s, uint level,
-                                      ivec3 cell, RESOCT_INOUT(uint) last_key,
+RESOCT_FN void resoct_request_missing(RESOCT_IN(ResoctSampleParams) f, RESOCT_IN(ResoctSlotInfo) s,
+                                      uint level, ivec3 cell, RESOCT_INOUT(uint) last_key,
                                       RESOCT_INOUT(ResoctRayStats) st) {
   uvec3 bs = resoct_frame_brick_size(f);
-  ResoctLevelInfo L = resoct_read_level(level);
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(level);
   uint key =
       resoct_brick_request_key(s.slot, level, f.level_count, L, resoct_brick_at(L, bs, cell));
   if (key == last_key) return;
@@ -238,7 +240,7 @@ RESOCT_FN void resoct_request_missing(ResoctSampleParams f, ResoctSlotInfo s, ui
   st.requests = st.requests + 1u;
   if (f.request_greedy == 0u) return;
   for (uint l = level + 1u; l <= s.coarsest_level; ++l) {
-    ResoctLevelInfo Lc = resoct_read_level(l);
+    RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(l);
     uvec3 b = resoct_brick_at(Lc, bs, cell);
     if (resoct_page_state(resoct_page_entry_of(s.slot, l, f.level_count, Lc, b)) !=
         RESOCT_PAGE_STATE_UNMAPPED) {
@@ -255,13 +257,14 @@ RESOCT_FN void resoct_request_missing(ResoctSampleParams f, ResoctSlotInfo s, ui
 /// to the box in which this answer holds: the target brick (coarser bricks contain it; requests
 /// and greedy requests are the same everywhere in it), and for a substitute also the node (its
 /// residency word chose the candidates) and a finer substitute's brick.
-RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotInfo s, uint node,
+RESOCT_FN ResoctSource resoct_residency_source(RESOCT_IN(ResoctSampleParams) f,
+                                               RESOCT_IN(ResoctSlotInfo) s, uint node,
                                                ivec3 node_lo, ivec3 node_hi, uint target,
                                                ivec3 cell, RESOCT_INOUT(uint) last_key,
                                                RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
                                                RESOCT_INOUT(ResoctRayStats) st) {
   uvec3 bs = resoct_frame_brick_size(f);
-  ResoctLevelInfo L = resoct_read_level(target);
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(target);
   uvec3 b = resoct_brick_at(L, bs, cell);
   resoct_box_clip_brick(lo, hi, L, bs, b);
   uint e = resoct_page_entry_of(s.slot, target, f.level_count, L, b);
@@ -277,7 +280,7 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
   int l = resoct_node_next_coarser(r, target);
   while (l >= 0) {
     uint lu = uint(l);
-    ResoctLevelInfo Lc = resoct_read_level(lu);
+    RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(lu);
     uvec3 bc = resoct_brick_at(Lc, bs, cell);
     uint ec = resoct_page_entry_of(s.slot, lu, f.level_count, Lc, bc);
     if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) {
@@ -288,7 +291,7 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
   l = resoct_node_next_finer(r, target);
   while (l >= 0) {
     uint lu = uint(l);
-    ResoctLevelInfo Lf = resoct_read_level(lu);
+    RESOCT_IN(ResoctLevelInfo) Lf = resoct_read_level(lu);
     uvec3 bf = resoct_brick_at(Lf, bs, cell);
     resoct_box_clip_brick(lo, hi, Lf, bs, bf);
     uint ef = resoct_page_entry_of(s.slot, lu, f.level_count, Lf, bf);
@@ -301,10 +304,10 @@ RESOCT_FN ResoctSource resoct_residency_source(ResoctSampleParams f, ResoctSlotI
 }
 
 /// Residency mode at one position (slices, shadow rays): resoct_residency_source, sampled.
-RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, uint node,
-                                        uint target, ivec3 cell, vec3 frac,
-                                        RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
-                                        RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN uint resoct_residency_channel(RESOCT_IN(ResoctSampleParams) f,
+                                        RESOCT_IN(ResoctSlotInfo) s, uint node, uint target,
+                                        ivec3 cell, vec3 frac, RESOCT_INOUT(uint) last_key,
+                                        RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
   ivec3 lo = cell;
   ivec3 hi = cell + ivec3(1);
   ResoctSource src =
@@ -314,14 +317,15 @@ RESOCT_FN uint resoct_residency_channel(ResoctSampleParams f, ResoctSlotInfo s, 
 
 /// Page-table mode, one channel: the target level or nothing (requested); [lo, hi) is clipped to
 /// the target brick. `skip_exit` receives the exit offset of an EMPTY brick.
-RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
-                                               ivec3 cell, vec3 frac, vec3 inv_vox,
-                                               RESOCT_INOUT(uint) last_key, RESOCT_INOUT(ivec3) lo,
-                                               RESOCT_INOUT(ivec3) hi, RESOCT_OUT(float) skip_exit,
+RESOCT_FN ResoctSource resoct_pagetable_source(RESOCT_IN(ResoctSampleParams) f,
+                                               RESOCT_IN(ResoctSlotInfo) s, uint target, ivec3 cell,
+                                               vec3 frac, vec3 inv_vox, RESOCT_INOUT(uint) last_key,
+                                               RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi,
+                                               RESOCT_OUT(float) skip_exit,
                                                RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
-  ResoctLevelInfo L = resoct_read_level(target);
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(target);
   uvec3 b = resoct_brick_at(L, bs, cell);
   resoct_box_clip_brick(lo, hi, L, bs, b);
   uint e = resoct_page_entry_of(s.slot, target, f.level_count, L, b);
@@ -349,7 +353,8 @@ RESOCT_FN ResoctSource resoct_pagetable_source(ResoctSampleParams f, ResoctSlotI
 /// record is requested (once per run of requests for it along the ray: `last_node`) and does not
 /// cull. Every mapped brick of the walk is marked used: the walk needs the whole path resident.
 /// [lo, hi) is clipped to the target brick, which every brick of the walk contains.
-RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo s, uint target,
+RESOCT_FN ResoctSource resoct_octree_source(RESOCT_IN(ResoctSampleParams) f,
+                                            RESOCT_IN(ResoctSlotInfo) s, uint target,
                                             uint start_depth, ivec3 cell, vec3 frac, vec3 inv_vox,
                                             RESOCT_INOUT(uint) last_key,
                                             RESOCT_INOUT(uint) last_node, RESOCT_INOUT(ivec3) lo,
@@ -357,7 +362,7 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
                                             RESOCT_INOUT(ResoctRayStats) st) {
   skip_exit = 0.0f;
   uvec3 bs = resoct_frame_brick_size(f);
-  ResoctLevelInfo Lt = resoct_read_level(target);
+  RESOCT_IN(ResoctLevelInfo) Lt = resoct_read_level(target);
   resoct_box_clip_brick(lo, hi, Lt, bs, resoct_brick_at(Lt, bs, cell));
   uint best_entry = RESOCT_PAGE_UNMAPPED_WORD;
   uint best_level = 0u;
@@ -366,7 +371,7 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
   while (l > target) {
     l = l - 1u;
     st.nodes = st.nodes + 1u;
-    ResoctLevelInfo L = resoct_read_level(l);
+    RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(l);
     uvec3 b = resoct_brick_at(L, bs, cell);
     uint e = resoct_page_entry_of(s.slot, l, f.level_count, L, b);
     uint state = resoct_page_state(e);
@@ -382,7 +387,7 @@ RESOCT_FN ResoctSource resoct_octree_source(ResoctSampleParams f, ResoctSlotInfo
     }
     if (state == RESOCT_PAGE_STATE_MAPPED) resoct_mark_used(resoct_page_cache_slot(e));
     if (L.node_depth != RESOCT_NONE_U) {
-      ResoctDepthInfo D = resoct_read_depth(L.node_depth);
+      RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(L.node_depth);
       uint node =
           resoct_node_index(L.node_depth, resoct_node_coord(D, cell), resoct_depth_count_log2(D));
       uint cls = resoct_node_class(node, s, f.node_slot_count);

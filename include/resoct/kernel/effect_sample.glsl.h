@@ -59,15 +59,15 @@ RESOCT_FN void resoct_fx_ray_clear(RESOCT_OUT(ResoctFxRay) fx) {
   }
 }
 
-RESOCT_FN float resoct_isovalue(ResoctSlotInfo s, uint k) {
+RESOCT_FN float resoct_isovalue(RESOCT_IN(ResoctSlotInfo) s, uint k) {
   return k == 0u ? s.iso0 : (k == 1u ? s.iso1 : (k == 2u ? s.iso2 : s.iso3));
 }
 
 /// Lit colour of a surface or sample of slot `s` at `level` and the position (cell, frac).
-RESOCT_FX_FN vec3 resoct_fx_shade(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
-                                  ResoctSlotInfo s, uint level, uint lod, ivec3 cell, vec3 frac,
-                                  float value, vec3 rgb, bool cast_shadow,
-                                  RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FX_FN vec3 resoct_fx_shade(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                  ResoctFxRayConst rc, RESOCT_IN(ResoctSlotInfo) s, uint level,
+                                  uint lod, ivec3 cell, vec3 frac, float value, vec3 rgb,
+                                  bool cast_shadow, RESOCT_INOUT(ResoctRayStats) st) {
   vec3 g = resoct_gradient(sp, p, s, level, cell, frac, value);
   st.gradient_evals = st.gradient_evals + 1u;
   vec3 pos_box = (vec3(cell) + frac) / resoct_fx_voxels_per_box(p);
@@ -90,10 +90,10 @@ RESOCT_FX_FN vec3 resoct_fx_shade(ResoctSampleParams sp, ResoctFxParams p, Resoc
 /// value (crossed first by a monotone field) is refined, the others are not drawn in this step.
 /// True with the hit's parameter and isovalue; the current sample becomes the previous one
 /// either way. One refinement per call keeps the inlined GPU code small.
-RESOCT_FN bool resoct_fx_iso_hit(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
-                                 uint c, ResoctSlotInfo s, float value, uint level, float tm,
-                                 RESOCT_INOUT(ResoctFxRay) fx, RESOCT_OUT(float) t_hit,
-                                 RESOCT_OUT(float) iso_hit) {
+RESOCT_FN bool resoct_fx_iso_hit(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                 ResoctFxRayConst rc, uint c, RESOCT_IN(ResoctSlotInfo) s,
+                                 float value, uint level, float tm, RESOCT_INOUT(ResoctFxRay) fx,
+                                 RESOCT_OUT(float) t_hit, RESOCT_OUT(float) iso_hit) {
   t_hit = tm;
   iso_hit = 0.0f;
   bool found = false;
@@ -125,12 +125,13 @@ RESOCT_FN bool resoct_fx_iso_hit(ResoctSampleParams sp, ResoctFxParams p, Resoct
 /// is the level the value came from, `lod` the view LOD level, `seg` the segment length. The
 /// lighting code appears once (one call of resoct_fx_shade) so that GPU compilers, which inline
 /// everything, compile it once.
-RESOCT_FX_FN void resoct_fx_channel(ResoctSampleParams sp, ResoctFxParams p, ResoctFxRayConst rc,
-                                    uint c, ResoctSlotInfo s, float value, uint level, uint lod,
-                                    float seg, float tm, ivec3 cell, vec3 frac,
-                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(ResoctPreintRay) pr,
-                                    RESOCT_INOUT(vec4) weighted, RESOCT_INOUT(float) combined,
-                                    RESOCT_INOUT(vec4) acc, RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FX_FN void resoct_fx_channel(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                    ResoctFxRayConst rc, uint c, RESOCT_IN(ResoctSlotInfo) s,
+                                    float value, uint level, uint lod, float seg, float tm,
+                                    ivec3 cell, vec3 frac, RESOCT_INOUT(ResoctFxRay) fx,
+                                    RESOCT_INOUT(ResoctPreintRay) pr, RESOCT_INOUT(vec4) weighted,
+                                    RESOCT_INOUT(float) combined, RESOCT_INOUT(vec4) acc,
+                                    RESOCT_INOUT(ResoctRayStats) st) {
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     if (s.mode == RESOCT_CHANNEL_MIP) {
       fx.proj[c] = max(fx.proj[c], clamp(value, 0.0f, 1.0f));
@@ -192,7 +193,7 @@ RESOCT_FN vec4 resoct_fx_projection_composite(ResoctFxRay fx, uint n, uint live,
   float combined;
   resoct_mix_begin(weighted, combined);
   for (uint c = 0u; c < n; ++c) {
-    ResoctSlotInfo s = resoct_read_slot(c);
+    RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(c);
     if (((live >> c) & 1u) == 0u || !resoct_is_projection(s)) continue;
     float v = fx.proj[c];
     if (s.mode == RESOCT_CHANNEL_AIP) v = length > 0.0f ? v / length : 0.0f;

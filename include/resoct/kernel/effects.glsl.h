@@ -122,13 +122,13 @@ RESOCT_FN ResoctFxParams resoct_fx_params(RESOCT_FRAME_IN f, ResoctFxFrame e) {
   return p;
 }
 
-RESOCT_FN vec3 resoct_fx_voxels_per_box(ResoctFxParams p) {
+RESOCT_FN vec3 resoct_fx_voxels_per_box(RESOCT_IN(ResoctFxParams) p) {
   return vec3(p.vpb_x, p.vpb_y, p.vpb_z);
 }
 
 /// Unit vector from a box-space position toward the light. The headlight shines along the view
 /// ray, so it points back along `view_dir`.
-RESOCT_FN vec3 resoct_light_vector(ResoctFxParams p, vec3 pos_box, vec3 view_dir) {
+RESOCT_FN vec3 resoct_light_vector(RESOCT_IN(ResoctFxParams) p, vec3 pos_box, vec3 view_dir) {
   if (p.light_kind == RESOCT_LIGHT_DIRECTIONAL) return -vec3(p.light_x, p.light_y, p.light_z);
   if (p.light_kind == RESOCT_LIGHT_POINT) {
     vec3 d = vec3(p.light_x, p.light_y, p.light_z) - pos_box;
@@ -142,7 +142,7 @@ RESOCT_FN vec3 resoct_light_vector(ResoctFxParams p, vec3 pos_box, vec3 view_dir
 /// unit vector toward the light, `view_dir` unit ray direction, `shadow` transmittance toward
 /// the light in [0, 1] (scales diffuse and specular, not ambient). A zero gradient has no
 /// normal: the colour is returned unshaded. Channels are clamped to [0, 1].
-RESOCT_FN vec3 resoct_blinn_phong(ResoctFxParams p, vec3 rgb, vec3 gradient, vec3 light,
+RESOCT_FN vec3 resoct_blinn_phong(RESOCT_IN(ResoctFxParams) p, vec3 rgb, vec3 gradient, vec3 light,
                                   vec3 view_dir, float shadow) {
   float g2 = dot(gradient, gradient);
   if (!(g2 > 0.0f)) return rgb;

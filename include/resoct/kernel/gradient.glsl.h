@@ -34,7 +34,7 @@
 RESOCT_KERNEL_BEGIN
 
 /// Clamps a level-0 position into the volume [0, extent), like resoct_clamp_position.
-RESOCT_FN void resoct_fx_clamp(ResoctFxParams p, RESOCT_INOUT(ivec3) cell,
+RESOCT_FN void resoct_fx_clamp(RESOCT_IN(ResoctFxParams) p, RESOCT_INOUT(ivec3) cell,
                                RESOCT_INOUT(vec3) frac) {
   ivec3 hi = ivec3(int(p.extent_x) - 1, int(p.extent_y) - 1, int(p.extent_z) - 1);
   for (int a = 0; a < 3; ++a) {
@@ -51,9 +51,10 @@ RESOCT_FN void resoct_fx_clamp(ResoctFxParams p, RESOCT_INOUT(ivec3) cell,
 
 /// Normalized value of a present page entry of brick `brick` at a level-0 position; `fallback`
 /// for UNMAPPED.
-RESOCT_FN float resoct_entry_normalized(ResoctSampleParams sp, ResoctSlotInfo s, uint entry,
-                                        ResoctLevelInfo L, uvec3 brick, ivec3 cell, vec3 frac,
-                                        float fallback) {
+RESOCT_FN float resoct_entry_normalized(RESOCT_IN(ResoctSampleParams) sp,
+                                        RESOCT_IN(ResoctSlotInfo) s, uint entry,
+                                        RESOCT_IN(ResoctLevelInfo) L, uvec3 brick, ivec3 cell,
+                                        vec3 frac, float fallback) {
   uint state = resoct_page_state(entry);
   if (state == RESOCT_PAGE_STATE_MAPPED) {
     float raw =
@@ -70,9 +71,9 @@ RESOCT_FN float resoct_entry_normalized(ResoctSampleParams sp, ResoctSlotInfo s,
 
 /// Normalized value of a channel at exactly `level` at a level-0 position inside the volume;
 /// false when that brick is not present. Never requests.
-RESOCT_FN bool resoct_level_value(ResoctSampleParams sp, ResoctSlotInfo s, uint level, ivec3 cell,
-                                  vec3 frac, RESOCT_OUT(float) value) {
-  ResoctLevelInfo L = resoct_read_level(level);
+RESOCT_FN bool resoct_level_value(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctSlotInfo) s,
+                                  uint level, ivec3 cell, vec3 frac, RESOCT_OUT(float) value) {
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(level);
   uvec3 b = resoct_brick_at(L, resoct_frame_brick_size(sp), cell);
   uint e = resoct_page_entry_of(s.slot, level, sp.level_count, L, b);
   value = 0.0f;
@@ -84,10 +85,10 @@ RESOCT_FN bool resoct_level_value(ResoctSampleParams sp, ResoctSlotInfo s, uint 
 /// The level resoct_residency_channel samples at a position (the target if present, else the
 /// nearest partially resident one, coarser first): gradients and isosurface refinement use the
 /// level the value came from. The target when no level is present.
-RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uint node, uint target,
-                                    ivec3 cell) {
+RESOCT_FN uint resoct_present_level(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctSlotInfo) s,
+                                    uint node, uint target, ivec3 cell) {
   uvec3 bs = resoct_frame_brick_size(sp);
-  ResoctLevelInfo L = resoct_read_level(target);
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(target);
   uint e = resoct_page_entry_of(s.slot, target, sp.level_count, L, resoct_brick_at(L, bs, cell));
   if (resoct_page_state(e) != RESOCT_PAGE_STATE_UNMAPPED) return target;
   uint r =
@@ -97,7 +98,7 @@ RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uin
   for (uint pass = 0u; pass < 2u; ++pass) {
     while (l >= 0) {
       uint lu = uint(l);
-      ResoctLevelInfo Lc = resoct_read_level(lu);
+      RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(lu);
       uint ec = resoct_page_entry_of(s.slot, lu, sp.level_count, Lc, resoct_brick_at(Lc, bs, cell));
       if (resoct_page_state(ec) != RESOCT_PAGE_STATE_UNMAPPED) return lu;
       l = pass == 0u ? resoct_node_next_coarser(r, lu) : resoct_node_next_finer(r, lu);
@@ -109,14 +110,14 @@ RESOCT_FN uint resoct_present_level(ResoctSampleParams sp, ResoctSlotInfo s, uin
 
 /// The level the standard-octree mode samples at a position (resoct_octree_channel): the finest
 /// present level above the first missing one, walking down from the coarsest to the target.
-RESOCT_FN uint resoct_octree_level(ResoctSampleParams sp, ResoctSlotInfo s, uint target,
-                                   ivec3 cell) {
+RESOCT_FN uint resoct_octree_level(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctSlotInfo) s,
+                                   uint target, ivec3 cell) {
   uvec3 bs = resoct_frame_brick_size(sp);
   uint best = target;
   uint l = s.coarsest_level + 1u;
   while (l > target) {
     l = l - 1u;
-    ResoctLevelInfo L = resoct_read_level(l);
+    RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(l);
     uint state = resoct_page_state(
         resoct_page_entry_of(s.slot, l, sp.level_count, L, resoct_brick_at(L, bs, cell)));
     if (state == RESOCT_PAGE_STATE_UNMAPPED) break;
@@ -128,9 +129,9 @@ RESOCT_FN uint resoct_octree_level(ResoctSampleParams sp, ResoctSlotInfo s, uint
 
 /// One gradient tap: the central brick when `same_brick`, else the tap's own brick if present,
 /// else the central brick; `fallback` when neither is present.
-RESOCT_FN float resoct_gradient_tap(ResoctSampleParams sp, ResoctSlotInfo s, uint level,
-                                    ResoctLevelInfo L, uint e0, uvec3 b0, bool same_brick,
-                                    ivec3 cell, vec3 frac, float fallback) {
+RESOCT_FN float resoct_gradient_tap(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctSlotInfo) s,
+                                    uint level, RESOCT_IN(ResoctLevelInfo) L, uint e0, uvec3 b0,
+                                    bool same_brick, ivec3 cell, vec3 frac, float fallback) {
   uint e = e0;
   uvec3 b = b0;
   if (!same_brick) {
@@ -148,9 +149,10 @@ RESOCT_FN float resoct_gradient_tap(ResoctSampleParams sp, ResoctSlotInfo s, uin
 
 /// Box-space gradient of the normalized field of slot `s` at `level` (see the file comment).
 /// `center` is the value at the position, used only when no brick of the level is present.
-RESOCT_FN vec3 resoct_gradient(ResoctSampleParams sp, ResoctFxParams p, ResoctSlotInfo s,
-                               uint level, ivec3 cell, vec3 frac, float center) {
-  ResoctLevelInfo L = resoct_read_level(level);
+RESOCT_FN vec3 resoct_gradient(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                               RESOCT_IN(ResoctSlotInfo) s, uint level, ivec3 cell, vec3 frac,
+                               float center) {
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(level);
   uvec3 b0 = resoct_brick_at(L, resoct_frame_brick_size(sp), cell);
   uint e0 = resoct_page_entry_of(s.slot, level, sp.level_count, L, b0);
   bool same = sp.halo >= 2u && resoct_page_state(e0) == RESOCT_PAGE_STATE_MAPPED;

@@ -108,9 +108,9 @@ RESOCT_FN float resoct_cubic_first_root(vec4 c, float smax) {
 }
 
 /// Value of `level` at ray parameter t (position clamped into the volume), false when missing.
-RESOCT_FN bool resoct_iso_value_at(ResoctSampleParams sp, ResoctFxParams p, ResoctSlotInfo s,
-                                   uint level, ivec3 o_cell, vec3 o_frac, vec3 dir_vox, float t,
-                                   RESOCT_OUT(float) value) {
+RESOCT_FN bool resoct_iso_value_at(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                   RESOCT_IN(ResoctSlotInfo) s, uint level, ivec3 o_cell,
+                                   vec3 o_frac, vec3 dir_vox, float t, RESOCT_OUT(float) value) {
   ivec3 cell;
   vec3 frac;
   resoct_ray_position(o_cell, o_frac, dir_vox, t, cell, frac);
@@ -130,11 +130,12 @@ RESOCT_FN float resoct_iso_plane_t(float t0, ivec3 cell, vec3 frac, vec3 dir_vox
 /// First t in [t0, t1] where the trilinear field of `level` equals `iso` along the ray, walking
 /// the level's cells in ray order; false when no cell of the bracket has a root (or its bricks
 /// are missing).
-RESOCT_FN bool resoct_iso_refine(ResoctSampleParams sp, ResoctFxParams p, ResoctSlotInfo s,
-                                 uint level, float iso, ivec3 o_cell, vec3 o_frac, vec3 dir_vox,
-                                 float t0, float t1, RESOCT_OUT(float) t_hit) {
+RESOCT_FN bool resoct_iso_refine(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                 RESOCT_IN(ResoctSlotInfo) s, uint level, float iso, ivec3 o_cell,
+                                 vec3 o_frac, vec3 dir_vox, float t0, float t1,
+                                 RESOCT_OUT(float) t_hit) {
   t_hit = t1;
-  ResoctLevelInfo L = resoct_read_level(level);
+  RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(level);
   uvec3 fl = resoct_level_factor(L);
   ivec3 h = ivec3(uvec3(1u) << fl);
   ivec3 cell;

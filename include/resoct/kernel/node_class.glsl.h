@@ -25,7 +25,7 @@ RESOCT_CONST(uint, RESOCT_MAX_DEPTHS, 32u);
 
 /// Child bits of a node coordinate at depth D: the low coordinate bit of each split axis, z then
 /// y then x with x least significant (OctreeLayout's order).
-RESOCT_FN uint resoct_node_child_bits(ResoctDepthInfo D, uvec3 c) {
+RESOCT_FN uint resoct_node_child_bits(RESOCT_IN(ResoctDepthInfo) D, uvec3 c) {
   uint bits = 0u;
   uint shift = 0u;
   if (D.split_x != 0u) {
@@ -41,13 +41,13 @@ RESOCT_FN uint resoct_node_child_bits(ResoctDepthInfo D, uvec3 c) {
 }
 
 /// Coordinates of the node at depth D containing a cell inside the volume.
-RESOCT_FN uvec3 resoct_node_coord(ResoctDepthInfo D, ivec3 cell) {
+RESOCT_FN uvec3 resoct_node_coord(RESOCT_IN(ResoctDepthInfo) D, ivec3 cell) {
   uvec3 c = uvec3(cell) / uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
   return min(c, uvec3(D.count_x - 1u, D.count_y - 1u, D.count_z - 1u));
 }
 
 /// Classifies one channel at a node from its own metadata record.
-RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
+RESOCT_FN uint resoct_node_class(uint node, RESOCT_IN(ResoctSlotInfo) s, uint node_slots) {
   uint base = resoct_node_base(node, s.slot, node_slots);
   uint flags = resoct_read_node(base + RESOCT_NODE_FLAGS);
   uint state = resoct_node_state(flags);
@@ -70,7 +70,7 @@ RESOCT_FN uint resoct_node_class(uint node, ResoctSlotInfo s, uint node_slots) {
 /// be EMPTY; its samples are then transparent, so sampling it instead of skipping leaves the image
 /// as it is. False for a homogeneous record (VALID, min = max), whose value the traversal uses
 /// without sampling.
-RESOCT_FN bool resoct_node_full(uint node, ResoctSlotInfo s, uint node_slots) {
+RESOCT_FN bool resoct_node_full(uint node, RESOCT_IN(ResoctSlotInfo) s, uint node_slots) {
   uint base = resoct_node_base(node, s.slot, node_slots);
   uint state = resoct_node_state(resoct_read_node(base + RESOCT_NODE_FLAGS));
   if (state == RESOCT_NODE_INVALID) return false;
@@ -88,7 +88,7 @@ RESOCT_FN bool resoct_node_full(uint node, ResoctSlotInfo s, uint node_slots) {
 RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, vec3 vpb, float dt) {
   uint depth = start_depth;
   for (uint d = start_depth + 1u; d < depth_count; ++d) {
-    ResoctDepthInfo D = resoct_read_depth(d);
+    RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
     float sx = float(D.node_extent_x) / vpb.x;
     float sy = float(D.node_extent_y) / vpb.y;
     float sz = float(D.node_extent_z) / vpb.z;
@@ -106,13 +106,13 @@ RESOCT_FN uint resoct_traversal_depth(RESOCT_FRAME_IN f, float dt) {
 }
 
 /// log2 of the node counts per axis at depth D (counts are powers of two).
-RESOCT_FN uvec3 resoct_depth_count_log2(ResoctDepthInfo D) {
+RESOCT_FN uvec3 resoct_depth_count_log2(RESOCT_IN(ResoctDepthInfo) D) {
   return uvec3(D.count_log2_x, D.count_log2_y, D.count_log2_z);
 }
 
 /// Coordinates at depth D of the ancestor of the node with coordinates `deep` at a deeper depth
 /// whose count_log2 is `deep_log2`: node boxes nest exactly, so this is a shift, not a division.
-RESOCT_FN uvec3 resoct_ancestor_coord(ResoctDepthInfo D, uvec3 deep, uvec3 deep_log2) {
+RESOCT_FN uvec3 resoct_ancestor_coord(RESOCT_IN(ResoctDepthInfo) D, uvec3 deep, uvec3 deep_log2) {
   return deep >> (deep_log2 - resoct_depth_count_log2(D));
 }
 
@@ -121,7 +121,7 @@ RESOCT_FN uvec3 resoct_ancestor_coord(ResoctDepthInfo D, uvec3 deep, uvec3 deep_
 RESOCT_FN uint resoct_node_index(uint depth, uvec3 coord, uvec3 coord_log2) {
   uint local = 0u;
   for (uint d = 1u; d <= depth; ++d) {
-    ResoctDepthInfo D = resoct_read_depth(d);
+    RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
     local = (local << D.child_shift) |
             resoct_node_child_bits(D, resoct_ancestor_coord(D, coord, coord_log2));
   }
@@ -139,7 +139,7 @@ RESOCT_FN uint resoct_node_neighbor_local(uint local, uint axis_bits, int step) 
 }
 
 /// The axis bits of depth D for axis `axis` (0 x, 1 y, 2 z).
-RESOCT_FN uint resoct_depth_axis_bits(ResoctDepthInfo D, uint axis) {
+RESOCT_FN uint resoct_depth_axis_bits(RESOCT_IN(ResoctDepthInfo) D, uint axis) {
   return axis == 0u ? D.axis_bits_x : (axis == 1u ? D.axis_bits_y : D.axis_bits_z);
 }
 
@@ -147,8 +147,8 @@ RESOCT_FN uint resoct_depth_axis_bits(ResoctDepthInfo D, uint axis) {
 /// of the nearest ancestor (down to `top`) that has, since a parent's record covers its children;
 /// INVALID when none has. Walks up by shifting the node's local index (a parent's local index is
 /// the child's without its child bits), so the walk is O(depth), not O(depth^2).
-RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, ResoctSlotInfo s,
-                                         uint node_slots) {
+RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top,
+                                         RESOCT_IN(ResoctSlotInfo) s, uint node_slots) {
   uint cls = resoct_node_class(node, s, node_slots);
   if (cls != RESOCT_NODE_CLASS_INVALID) return cls;
   uint d = depth;
@@ -168,7 +168,7 @@ RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top, Resoct
 RESOCT_FN uint resoct_level_depth_cap(uint start_depth, uint depth_count, uvec3 factor_log2) {
   uint depth = start_depth;
   for (uint d = start_depth + 1u; d < depth_count; ++d) {
-    ResoctDepthInfo D = resoct_read_depth(d);
+    RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
     if ((D.node_extent_x >> factor_log2.x) < 2u || (D.node_extent_y >> factor_log2.y) < 2u ||
         (D.node_extent_z >> factor_log2.z) < 2u) {
       break;

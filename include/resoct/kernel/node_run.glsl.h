@@ -52,7 +52,7 @@ RESOCT_FN float resoct_node_run_end(RESOCT_FRAME_IN f, uint bank, uint n, uint l
                                     vec3 frac, vec3 dir_vox, vec3 inv_vox, float node_end,
                                     ivec3 box_lo, ivec3 box_hi,
                                     RESOCT_INOUT(ResoctRayStats) stats) {
-  ResoctDepthInfo D = resoct_read_depth(depth);
+  RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(depth);
   ivec3 ne = ivec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
   uvec3 count = uvec3(D.count_x, D.count_y, D.count_z);
   uint local = node - D.first_node;

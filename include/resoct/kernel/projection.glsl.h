@@ -22,18 +22,18 @@
 
 RESOCT_KERNEL_BEGIN
 
-RESOCT_FN bool resoct_is_projection(ResoctSlotInfo s) {
+RESOCT_FN bool resoct_is_projection(RESOCT_IN(ResoctSlotInfo) s) {
   return s.mode == RESOCT_CHANNEL_MIP || s.mode == RESOCT_CHANNEL_AIP;
 }
 
 /// Largest 16-bit node maximum that cannot change a projection whose running value is `beat`.
-RESOCT_FN uint resoct_projection_threshold16(ResoctSlotInfo s, float beat) {
+RESOCT_FN uint resoct_projection_threshold16(RESOCT_IN(ResoctSlotInfo) s, float beat) {
   if (s.mode == RESOCT_CHANNEL_AIP) return 0u;
   return uint(floor(clamp(beat, 0.0f, 1.0f) * float(RESOCT_QUANT_MAX)));
 }
 
 /// Class of a MIP/AIP channel at a node from its own record (see the file comment).
-RESOCT_FN uint resoct_projection_node_class(uint node, ResoctSlotInfo s, uint node_slots,
+RESOCT_FN uint resoct_projection_node_class(uint node, RESOCT_IN(ResoctSlotInfo) s, uint node_slots,
                                             uint threshold16) {
   uint base = resoct_node_base(node, s.slot, node_slots);
   uint state = resoct_node_state(resoct_read_node(base + RESOCT_NODE_FLAGS));
@@ -50,8 +50,9 @@ RESOCT_FN uint resoct_projection_node_class(uint node, ResoctSlotInfo s, uint no
 
 /// As resoct_node_class_carried, for any channel mode: projection channels by value, the others
 /// by their visible range. `beat` is the channel's running projection value.
-RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top, ResoctSlotInfo s,
-                                              uint node_slots, float beat) {
+RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top,
+                                              RESOCT_IN(ResoctSlotInfo) s, uint node_slots,
+                                              float beat) {
   if (!resoct_is_projection(s)) return resoct_node_class_carried(node, depth, top, s, node_slots);
   uint thr = resoct_projection_threshold16(s, beat);
   uint cls = resoct_projection_node_class(node, s, node_slots, thr);
@@ -67,7 +68,8 @@ RESOCT_FN uint resoct_mode_node_class_carried(uint node, uint depth, uint top, R
 }
 
 /// The mode-aware class of a channel at its own node record (no ancestor walk).
-RESOCT_FN uint resoct_mode_node_class(uint node, ResoctSlotInfo s, uint node_slots, float beat) {
+RESOCT_FN uint resoct_mode_node_class(uint node, RESOCT_IN(ResoctSlotInfo) s, uint node_slots,
+                                      float beat) {
   if (!resoct_is_projection(s)) return resoct_node_class(node, s, node_slots);
   return resoct_projection_node_class(node, s, node_slots, resoct_projection_threshold16(s, beat));
 }

@@ -31,7 +31,8 @@
 RESOCT_KERNEL_BEGIN
 
 /// Whether the value crossed any isovalue of an iso slot between `prev` and `v`.
-RESOCT_FN bool resoct_iso_crossed(ResoctSlotInfo s, float prev, float v, RESOCT_OUT(float) iso) {
+RESOCT_FN bool resoct_iso_crossed(RESOCT_IN(ResoctSlotInfo) s, float prev, float v,
+                                  RESOCT_OUT(float) iso) {
   iso = 0.0f;
   for (uint k = 0u; k < s.iso_count && k < RESOCT_MAX_ISOVALUES; ++k) {
     float x = k == 0u ? s.iso0 : (k == 1u ? s.iso1 : (k == 2u ? s.iso2 : s.iso3));
@@ -47,16 +48,16 @@ RESOCT_FN bool resoct_iso_crossed(ResoctSlotInfo s, float prev, float v, RESOCT_
 /// box-space vector toward the light, `max_t` the distance to a point light (box units; huge for
 /// directional light), `lod` the view LOD level at the position, `live` the slots that take
 /// part (see traverse.glsl.h).
-RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParams p, uint n,
-                                            uint live, ivec3 cell0, vec3 frac0, vec3 light,
-                                            float max_t, uint lod,
-                                            RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN float resoct_shadow_transmittance(RESOCT_IN(ResoctSampleParams) sp,
+                                            RESOCT_IN(ResoctFxParams) p, uint n, uint live,
+                                            ivec3 cell0, vec3 frac0, vec3 light, float max_t,
+                                            uint lod, RESOCT_INOUT(ResoctRayStats) st) {
   st.shadow_rays = st.shadow_rays + 1u;
   vec3 vpb = resoct_fx_voxels_per_box(p);
   vec3 dir_vox = light * vpb;
   vec3 inv_vox = resoct_ray_inverse(dir_vox);
   uint base = min(lod + p.shadow_lod_shift, sp.level_count - 1u);
-  ResoctLevelInfo Lb = resoct_read_level(base);
+  RESOCT_IN(ResoctLevelInfo) Lb = resoct_read_level(base);
   vec3 level_voxel = vec3(uvec3(1u) << resoct_level_factor(Lb)) / vpb;
   float dt = resoct_step_size(light, level_voxel, p.step_scale, p.min_step);
   float inv_dt = 1.0f / dt;
@@ -64,7 +65,7 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
   vec3 vol_hi = vec3(ivec3(int(p.extent_x), int(p.extent_y), int(p.extent_z)) - cell0);
   float t_exit = min(resoct_ray_box_inv(frac0, inv_vox, vol_lo, vol_hi).y, max_t);
   uint depth = resoct_traversal_depth_for(p.start_depth, p.depth_count, vpb, dt);
-  ResoctDepthInfo Dt = resoct_read_depth(depth);
+  RESOCT_IN(ResoctDepthInfo) Dt = resoct_read_depth(depth);
   uvec3 dlog2 = resoct_depth_count_log2(Dt);
 
   float transmit = 1.0f;
@@ -90,7 +91,7 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
       empty = 0u;
       homog = 0u;
       for (uint c = 0u; c < n; ++c) {
-        ResoctSlotInfo s = resoct_read_slot(c);
+        RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(c);
         uint cls = RESOCT_NODE_CLASS_EMPTY;
         if (((live >> c) & 1u) != 0u && !resoct_is_projection(s)) {
           cls = resoct_node_class_carried(node, depth, p.start_depth, s, sp.node_slot_count);
@@ -113,7 +114,7 @@ RESOCT_FN float resoct_shadow_transmittance(ResoctSampleParams sp, ResoctFxParam
     }
     for (uint c = 0u; c < n; ++c) {
       if (((empty >> c) & 1u) != 0u) continue;
-      ResoctSlotInfo s = resoct_read_slot(c);
+      RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(c);
       float value = 0.0f;
       uint res = RESOCT_CH_VALUE;
       if (((homog >> c) & 1u) != 0u) {

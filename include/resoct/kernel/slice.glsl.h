@@ -69,9 +69,10 @@ RESOCT_FN uint resoct_slice_lod(RESOCT_FRAME_IN f, uint i, vec3 dir_box, float t
 /// nearest level partially resident in the finest octree node at the point (coarser first, then
 /// finer), each candidate checked by its page entry. False when nothing is present. EMPTY is
 /// value 0 here (an EMPTY brick is all zero).
-RESOCT_FN bool resoct_slice_channel(ResoctSampleParams p, ResoctSlotInfo s, uint node, uint target,
-                                    ivec3 cell, vec3 frac, RESOCT_INOUT(uint) last_key,
-                                    RESOCT_OUT(float) value, RESOCT_INOUT(ResoctRayStats) st) {
+RESOCT_FN bool resoct_slice_channel(RESOCT_IN(ResoctSampleParams) p, RESOCT_IN(ResoctSlotInfo) s,
+                                    uint node, uint target, ivec3 cell, vec3 frac,
+                                    RESOCT_INOUT(uint) last_key, RESOCT_OUT(float) value,
+                                    RESOCT_INOUT(ResoctRayStats) st) {
   uint res = resoct_residency_channel(p, s, node, target, cell, frac, last_key, value, st);
   if (res == RESOCT_CH_EMPTY) value = 0.0f;
   return res != RESOCT_CH_NONE;
@@ -80,14 +81,14 @@ RESOCT_FN bool resoct_slice_channel(ResoctSampleParams p, ResoctSlotInfo s, uint
 /// Flat index of the finest octree node containing a cell inside the volume.
 RESOCT_FN uint resoct_slice_node(RESOCT_FRAME_IN f, ivec3 cell) {
   uint depth = f.depth_count - 1u;
-  ResoctDepthInfo D = resoct_read_depth(depth);
+  RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(depth);
   uvec3 c = min(uvec3(cell) / uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z),
                 uvec3(D.count_x - 1u, D.count_y - 1u, D.count_z - 1u));
   uvec3 c_log2 =
       uvec3(uint(findMSB(D.count_x)), uint(findMSB(D.count_y)), uint(findMSB(D.count_z)));
   uint local = 0u;
   for (uint d = 1u; d <= depth; ++d) {
-    ResoctDepthInfo Dd = resoct_read_depth(d);
+    RESOCT_IN(ResoctDepthInfo) Dd = resoct_read_depth(d);
     uvec3 a = c >> (c_log2 - uvec3(uint(findMSB(Dd.count_x)), uint(findMSB(Dd.count_y)),
                                    uint(findMSB(Dd.count_z))));
     uint bits = 0u;
@@ -125,7 +126,7 @@ RESOCT_FN vec4 resoct_slice_shade(RESOCT_FRAME_IN f, uint i, ivec3 origin_cell, 
   uint n = min(f.slot_count, RESOCT_MAX_SLOTS);
   for (uint c = 0u; c < n; ++c) {
     if (((mask >> c) & 1u) == 0u) continue;
-    ResoctSlotInfo s = resoct_read_slot(c);
+    RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(c);
     uint last_key = RESOCT_REQUEST_KEY_NONE;
     float value;
     uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);

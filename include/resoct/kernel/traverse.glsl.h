@@ -272,7 +272,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             uvec3 coarse_f = uvec3(0u);
             for (uint c = 0u; c < n; ++c) {
               if (((live >> c) & 1u) == 0u) continue;
-              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint lc = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               cap_level = min(cap_level, lc);
               coarse_f = max(coarse_f, resoct_level_factor(resoct_read_level(lc)));
@@ -287,7 +287,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
                            resoct_in_box(cell, cached_lo, cached_hi);
           if (!same_node) {
-            ResoctDepthInfo Dt = resoct_read_depth(cap_depth);
+            RESOCT_IN(ResoctDepthInfo) Dt = resoct_read_depth(cap_depth);
             uvec3 trav_coord = resoct_node_coord(Dt, cell);
             uvec3 trav_log2 = resoct_depth_count_log2(Dt);
             uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
@@ -343,7 +343,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               }
             }
             for (uint d = d_first; d <= cap_depth; ++d) {
-              ResoctDepthInfo D = resoct_read_depth(d);
+              RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
               if (d > 0u) {
                 local = (local << D.child_shift) |
                         resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
@@ -414,7 +414,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             }
             cached_empty = state;
             if (full_depth != RESOCT_NONE_U) {
-              ResoctDepthInfo Df = resoct_read_depth(full_depth);
+              RESOCT_IN(ResoctDepthInfo) Df = resoct_read_depth(full_depth);
               cached_node = Df.first_node + local;
               uvec3 fne = uvec3(Df.node_extent_x, Df.node_extent_y, Df.node_extent_z);
               cached_lo = ivec3(resoct_ancestor_coord(Df, trav_coord, trav_log2) * fne);
@@ -432,7 +432,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                   cached_empty = cached_empty | (1u << c);
                   continue;
                 }
-                ResoctSlotInfo sc = resoct_read_slot(bank + c);
+                RESOCT_IN(ResoctSlotInfo) sc = resoct_read_slot(bank + c);
                 uint cls;
                 RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
                   cls = resoct_mode_node_class(cached_node, sc, f.node_slot_count, fx.proj[c]);
@@ -468,7 +468,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                 stats.requests = stats.requests + 1u;
               }
             } else {
-              ResoctDepthInfo Dk = resoct_read_depth(cached_skip_depth);
+              RESOCT_IN(ResoctDepthInfo) Dk = resoct_read_depth(cached_skip_depth);
               cached_node = Dk.first_node + path_local[cached_skip_depth];
             }
           }
@@ -478,7 +478,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           // part is a new decision.
           uint live_mask = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
           if (cached_skip_depth != RESOCT_NONE_U) {
-            ResoctDepthInfo Ds = resoct_read_depth(cached_skip_depth);
+            RESOCT_IN(ResoctDepthInfo) Ds = resoct_read_depth(cached_skip_depth);
             ivec3 ne = ivec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
             class_lo = ivec3(resoct_node_coord(Ds, cell)) * ne;
             class_hi = class_lo + ne;
@@ -553,7 +553,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             for (uint c = 0u; c < n; ++c) {
               src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
               if ((((live & ~class_empty) >> c) & 1u) == 0u) continue;
-              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               if (((class_homog >> c) & 1u) != 0u) {
                 // Homogeneous here: the node's value, no brick.
                 uint mm = resoct_read_node(resoct_node_base(node, s.slot, f.node_slot_count) +
@@ -587,7 +587,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             for (uint c = 0u; c < n; ++c) {
               src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
               if (((live >> c) & 1u) == 0u) continue;
-              ResoctSlotInfo s = resoct_read_slot(bank + c);
+              RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               float exit_c = 0.0f;
               if (f.mode == RESOCT_MODE_OCTREE) {
@@ -681,7 +681,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           float value;
           resoct_source_sample_t(src[c], tm, value, stats);
           RESOCT_IF_FX(RESOCT_EFFECT_ANY) {
-            ResoctSlotInfo s = resoct_read_slot(bank + c);
+            RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
             uint level = resoct_channel_level(seg_lod, s.finest_level, s.coarsest_level);
             RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
               if (f.mode == RESOCT_MODE_RESIDENCY) {
