@@ -261,7 +261,7 @@ RayTotals render_tiles(const KernelContext& ctx, const kernel::ResoctFrame& fram
           requests += st.requests;
           skipped += double(st.skipped);
           marched += double(st.marched);
-          if constexpr (EFFECTS != 0u) {
+          if constexpr ((EFFECTS & (kernel::RESOCT_EFFECT_MASKS - 1u)) != 0u) {
             gradients += st.gradient_evals;
             shadow_rays += st.shadow_rays;
           }

@@ -50,6 +50,38 @@ RESOCT_CONST(uint, RESOCT_EFFECT_MASKS, 32u);
 /// Pre-integration alone only changes the DVR lookup and stays on the plain path.
 RESOCT_CONST(uint, RESOCT_EFFECT_ANY, 15u);
 
+// The render mode as part of a C++ specialization: bits RESOCT_EFFECT_MODE_SHIFT and up of a
+// mask hold the mode + 1 (RESOCT_MODE_*), 0 meaning "the frame's mode, at run time". The CPU
+// backend instantiates its plain kernel once per mode, so that a residency frame's code holds no
+// page-table or octree branch (fewer live values across the march loop, measured with
+// callgrind: bench/README.md "Fifteenth pass"). GLSL always reads the frame's mode.
+RESOCT_CONST(uint, RESOCT_EFFECT_MODE_SHIFT, 8u);
+// Likewise a frame of one channel (ResoctFrame.slot_count == 1): the channel loops then run
+// once by construction.
+RESOCT_CONST(uint, RESOCT_EFFECT_ONE_SLOT, 128u);
+#ifdef __cplusplus
+/// The mask of effects `effects` specialized for render mode `mode`.
+constexpr uint resoct_fx_with_mode(uint effects, uint mode) {
+  return effects | ((mode + 1u) << RESOCT_EFFECT_MODE_SHIFT);
+}
+/// The mode a specialization was compiled for, else `frame_mode`.
+template <uint E>
+constexpr uint resoct_fx_mode(uint frame_mode) {
+  return (E >> RESOCT_EFFECT_MODE_SHIFT) != 0u ? (E >> RESOCT_EFFECT_MODE_SHIFT) - 1u : frame_mode;
+}
+/// The channels of a frame (ResoctFrame.slot_count, at most RESOCT_MAX_SLOTS): 1 in a
+/// RESOCT_EFFECT_ONE_SLOT specialization.
+template <uint E>
+constexpr uint resoct_fx_slot_count(uint frame_slots) {
+  return (E & RESOCT_EFFECT_ONE_SLOT) != 0u ? 1u : min(frame_slots, RESOCT_MAX_SLOTS);
+}
+#define RESOCT_FX_MODE(f) resoct_fx_mode<RESOCT_EFFECTS>((f).mode)
+#define RESOCT_FX_SLOT_COUNT(f) resoct_fx_slot_count<RESOCT_EFFECTS>((f).slot_count)
+#else
+#define RESOCT_FX_MODE(f) ((f).mode)
+#define RESOCT_FX_SLOT_COUNT(f) min((f).slot_count, RESOCT_MAX_SLOTS)
+#endif
+
 // Channel modes (ResoctSlotInfo.mode).
 RESOCT_CONST(uint, RESOCT_CHANNEL_DVR, 0u);
 RESOCT_CONST(uint, RESOCT_CHANNEL_ISO, 1u);

@@ -78,12 +78,14 @@ RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
 RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                                          RESOCT_OUT(ResoctRayStats) stats) {
   resoct_stats_clear(stats);
+  // The render mode: a constant in the CPU backend's per-mode specializations (effects.glsl.h).
+  uint mode = RESOCT_FX_MODE(f);
   vec4 background = vec4(f.background_r, f.background_g, f.background_b, f.background_a);
   vec4 acc = vec4(0.0f);
 
   // Channels whose transfer function is invisible everywhere never contribute: drop them in
   // every mode (no samples, no requests).
-  uint n = min(f.slot_count, RESOCT_MAX_SLOTS);
+  uint n = RESOCT_FX_SLOT_COUNT(f);
   uint live = 0u;
   for (uint i = 0u; i < n; ++i) {
     if (resoct_read_slot(i).vis_bins != 0u) live = live | (1u << i);
@@ -261,7 +263,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         uint class_empty = 0u;
         uint class_homog = 0u;
         uint node = 0u;
-        if (f.mode == RESOCT_MODE_RESIDENCY) {
+        if (mode == RESOCT_MODE_RESIDENCY) {
           // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
           // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
           // The LOD level changes rarely along a ray; a new slice/lens segment (cached_node
@@ -541,7 +543,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           seg_empty = class_empty;
           seg_homog = class_homog;
           seg_node_dep = false;
-          if (f.mode == RESOCT_MODE_RESIDENCY) {
+          if (mode == RESOCT_MODE_RESIDENCY) {
             // Channels the node does not settle may still be settled by their bricks: an EMPTY
             // brick (page state) is transparent over its box, as in page-table mode. When every
             // channel is settled one way or the other, the march skips to the first place where
@@ -590,7 +592,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               float exit_c = 0.0f;
-              if (f.mode == RESOCT_MODE_OCTREE) {
+              if (mode == RESOCT_MODE_OCTREE) {
                 src[c] = resoct_octree_source(sp, s, target, f.start_depth, cell, frac, inv_vox,
                                               last_key[c], last_node_request, src_lo, src_hi,
                                               exit_c, stats);
@@ -627,9 +629,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         // crossing into them is no decision (docs/rendering.md "Segments"). Only where nothing
         // at the node settles a channel (no empty or homogeneous class, no source chosen by the
         // node), and not for projections, whose classes follow the values along the ray.
-        bool merge = f.mode == RESOCT_MODE_RESIDENCY && !skip &&
-                     cached_skip_depth == RESOCT_NONE_U && cached_full == 0u && class_empty == 0u &&
-                     class_homog == 0u && !seg_node_dep;
+        bool merge = mode == RESOCT_MODE_RESIDENCY && !skip && cached_skip_depth == RESOCT_NONE_U &&
+                     cached_full == 0u && class_empty == 0u && class_homog == 0u && !seg_node_dep;
         RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
           merge = false;
         }
@@ -684,9 +685,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
             uint level = resoct_channel_level(seg_lod, s.finest_level, s.coarsest_level);
             RESOCT_IF_FX(RESOCT_EFFECT_SHADING | RESOCT_EFFECT_ISO) {
-              if (f.mode == RESOCT_MODE_RESIDENCY) {
+              if (mode == RESOCT_MODE_RESIDENCY) {
                 level = resoct_present_level(sp, s, seg_node, level, cell);
-              } else if (f.mode == RESOCT_MODE_OCTREE) {
+              } else if (mode == RESOCT_MODE_OCTREE) {
                 level = resoct_octree_level(sp, s, level, cell);
               }
             }
