@@ -1,6 +1,6 @@
-// The residency traversal's descent (kernel/traverse.glsl.h): restarting below the deepest node
-// shared with the previous descent, and capping the depth at the sampled level's "leaves", must
-// never change which visible samples run. Checked against descent-free renders (start_depth at
+// The residency traversal's descent (kernel/residency_descent.glsl.h): restarting below the deepest
+// node shared with the previous descent, and capping the depth at the sampled level's "leaves",
+// must never change which visible samples run. Checked against descent-free renders (start_depth at
 // the traversal depth: every node classified from its own record only) and against page-table
 // mode, over seeded random cameras.
 #include <cmath>

@@ -50,6 +50,7 @@
 #include "resoct/kernel/projection.glsl.h"
 #include "resoct/kernel/ray.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
+#include "resoct/kernel/residency_descent.glsl.h"
 #include "resoct/kernel/sample.glsl.h"
 #include "resoct/kernel/segment_samples.glsl.h"
 #include "resoct/kernel/segments.glsl.h"
@@ -124,33 +125,10 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
   for (uint i = 0u; i < RESOCT_MAX_SLOTS; ++i) last_key[i] = RESOCT_REQUEST_KEY_NONE;
   uint last_node_request = RESOCT_NONE_U;
 
-  // Residency mode: classification of the last traversal node (depth cached_depth, level-0 box
-  // [cached_lo, cached_hi)), reused while samples stay in it. RESOCT_NONE_U in cached_node (also
-  // set by resoct_segment_advance when the bank changes) drops it and the descent path.
-  uint cached_node = RESOCT_NONE_U;
-  uvec3 cached_coord = uvec3(RESOCT_NONE_U);
-  uint cached_depth = 0u;
-  ivec3 cached_lo = ivec3(0);
-  ivec3 cached_hi = ivec3(0);
-  uint cached_empty = 0u;
-  uint cached_homog = 0u;
-  uint cached_skip_depth = RESOCT_NONE_U;
-  // 1 when the cached node is an ancestor of the traversal node at which the descent stopped
-  // because no node below it can be EMPTY for a live channel (resoct_node_full): then its whole
-  // box is one visible node, with no descent, classification or run inside it.
-  uint cached_full = 0u;
-  // Plain rendering only: effects and pre-integration read values or node words whose results
-  // the descent's depth could change.
-  bool full_stops = true;
-  RESOCT_IF_FX(RESOCT_EFFECT_ANY | RESOCT_EFFECT_PREINT) {
-    full_stops = false;
-  }
-  // The last descent's path: per depth d in [start_depth, path_end] the node's local index and
-  // the channels found empty down to it; path_skip = 1 when every channel was empty at path_end.
-  uint path_local[RESOCT_MAX_DEPTHS];
-  uint path_empty[RESOCT_MAX_DEPTHS];
-  uint path_end = RESOCT_NONE_U;
-  uint path_skip = 0u;
+  // Residency mode: the last traversal node and the path to it (kernel/residency_descent.glsl.h).
+  ResoctDescent ds;
+  ResoctDescentPath dp;
+  resoct_descent_clear(ds, dp);
   // The traversal depth capped for the LOD level cap_lod (RESOCT_NONE_U: not computed yet).
   uint cap_lod = RESOCT_NONE_U;
   uint cap_depth = trav_depth;
@@ -266,9 +244,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         if (mode == RESOCT_MODE_RESIDENCY) {
           // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
           // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
-          // The LOD level changes rarely along a ray; a new slice/lens segment (cached_node
+          // The LOD level changes rarely along a ray; a new slice/lens segment (ds.node
           // reset) may change the bank and with it the channels' level ranges.
-          if (lod != cap_lod || cached_node == RESOCT_NONE_U) {
+          if (lod != cap_lod || ds.node == RESOCT_NONE_U) {
             cap_lod = lod;
             uint cap_level = RESOCT_NONE_U;
             uvec3 coarse_f = uvec3(0u);
@@ -285,202 +263,18 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                                             resoct_level_factor(resoct_read_level(cap_level))));
             margin = resoct_culling_margin(coarse_f);
           }
-          // Consecutive samples mostly stay in one node: a box test then, no division, no walk.
-          bool same_node = cached_node != RESOCT_NONE_U && cap_depth == cached_depth &&
-                           resoct_in_box(cell, cached_lo, cached_hi);
-          if (!same_node) {
-            RESOCT_IN(ResoctDepthInfo) Dt = resoct_read_depth(cap_depth);
-            uvec3 trav_coord = resoct_node_coord(Dt, cell);
-            uvec3 trav_log2 = resoct_depth_count_log2(Dt);
-            uvec3 ne = uvec3(Dt.node_extent_x, Dt.node_extent_y, Dt.node_extent_z);
-            cached_lo = ivec3(trav_coord * ne);
-            cached_hi = cached_lo + ivec3(ne);
-            uvec3 prev_coord = cached_coord;
-            uint prev_depth = cached_depth;
-            cached_coord = trav_coord;
-            // Alg. 7.5: one descent for all channels in importance order; a channel empty at a
-            // node advances the channel index in the same node. `state` = channels empty so far
-            // (always channels 0 .. ci - 1). The descent restarts below the deepest node it
-            // shares with the previous descent's path (whose results depend only on that node and
-            // its ancestors), except for projection channels, whose class follows the running
-            // value along the ray.
-            uint reuse_end = cached_node == RESOCT_NONE_U ? RESOCT_NONE_U : path_end;
-            RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-              reuse_end = RESOCT_NONE_U;
-            }
-            bool on_path = reuse_end != RESOCT_NONE_U;
-            cached_depth = cap_depth;
-            cached_homog = 0u;
-            cached_skip_depth = RESOCT_NONE_U;
-            cached_full = 0u;
-            uint full_depth = RESOCT_NONE_U;
-            uint state = 0u;
-            uint local = 0u;
-            uint d_first = 0u;
-            if (on_path && prev_depth == cap_depth) {
-              // The deepest depth k of the previous path whose node is also the new node's
-              // ancestor (their coordinates agree above that depth's count bits): depths up to k
-              // are reused without walking them.
-              uvec3 diff = trav_coord ^ prev_coord;
-              uint k = reuse_end;
-              for (;;) {
-                uvec3 sh = trav_log2 - resoct_depth_count_log2(resoct_read_depth(k));
-                if ((diff.x >> sh.x) == 0u && (diff.y >> sh.y) == 0u && (diff.z >> sh.z) == 0u) {
-                  break;
-                }
-                if (k <= f.start_depth) {
-                  k = RESOCT_NONE_U;
-                  break;
-                }
-                k = k - 1u;
-              }
-              if (k != RESOCT_NONE_U) {
-                state = path_empty[k];
-                local = path_local[k];
-                d_first = k + 1u;
-                if (k == reuse_end && path_skip != 0u) {
-                  cached_skip_depth = k;
-                  d_first = cap_depth + 1u;
-                }
-              }
-            }
-            for (uint d = d_first; d <= cap_depth; ++d) {
-              RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
-              if (d > 0u) {
-                local = (local << D.child_shift) |
-                        resoct_node_child_bits(D, resoct_ancestor_coord(D, trav_coord, trav_log2));
-              }
-              if (d < f.start_depth) continue;
-              if (on_path && d <= reuse_end && path_local[d] == local) {
-                state = path_empty[d];
-                if (d == reuse_end && path_skip != 0u) {
-                  cached_skip_depth = d;
-                  break;
-                }
-                continue;
-              }
-              // From here on the path differs from the previous one: drop its deeper entries.
-              on_path = false;
-              path_local[d] = local;
-              path_end = d > f.start_depth ? d - 1u : RESOCT_NONE_U;
-              path_skip = 0u;
-              if (d == cap_depth) break;  // the traversal node: classified below
-              stats.nodes = stats.nodes + 1u;
-              uint nd = D.first_node + local;
-              uint ci = uint(bitCount(state));
-              while (ci < n) {
-                bool empty = ((live >> ci) & 1u) == 0u;
-                if (!empty) {
-                  uint cls;
-                  RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                    cls = resoct_mode_node_class_carried(nd, d, f.start_depth,
-                                                         resoct_read_slot(bank + ci),
-                                                         f.node_slot_count, fx.proj[ci]);
-                  }
-                  else {
-                    cls = resoct_node_class_carried(nd, d, f.start_depth,
-                                                    resoct_read_slot(bank + ci), f.node_slot_count);
-                  }
-                  empty = cls == RESOCT_NODE_CLASS_EMPTY;
-                }
-                if (!empty) break;
-                state = state | (1u << ci);
-                ci = ci + 1u;
-              }
-              path_empty[d] = state;
-              path_end = d;
-              path_skip = ci == n ? 1u : 0u;
-              if (ci == n) {
-                cached_skip_depth = d;
-                break;
-              }
-              if (full_stops) {
-                // Channel ci is visible here; when it and every later live channel are full, no
-                // node below can be skipped for them: this node is the traversal node. Full is
-                // the frame's visible-subtree bit (every node below checked on the host), or the
-                // node's own record when its range proves it.
-                uint visible_below = resoct_read_visible_subtrees(nd);
-                bool full = true;
-                for (uint c = ci; c < n && full; ++c) {
-                  if (((live >> c) & 1u) != 0u) {
-                    uint e = bank + c;
-                    full = (e < RESOCT_MAX_SLOTS && ((visible_below >> e) & 1u) != 0u) ||
-                           resoct_node_full(nd, resoct_read_slot(e), f.node_slot_count);
-                  }
-                }
-                if (full) {
-                  full_depth = d;
-                  break;
-                }
-              }
-            }
-            cached_empty = state;
-            if (full_depth != RESOCT_NONE_U) {
-              RESOCT_IN(ResoctDepthInfo) Df = resoct_read_depth(full_depth);
-              cached_node = Df.first_node + local;
-              uvec3 fne = uvec3(Df.node_extent_x, Df.node_extent_y, Df.node_extent_z);
-              cached_lo = ivec3(resoct_ancestor_coord(Df, trav_coord, trav_log2) * fne);
-              cached_hi = cached_lo + ivec3(fne);
-              cached_full = 1u;
-            } else if (cached_skip_depth == RESOCT_NONE_U) {
-              // The remaining channels at the traversal node. A node whose own record is INVALID
-              // is requested; its class is carried down from the nearest ancestor with metadata
-              // (not empty when there is none).
-              cached_node = Dt.first_node + local;
-              stats.nodes = stats.nodes + 1u;
-              uint invalid = 0u;
-              for (uint c = uint(bitCount(state)); c < n; ++c) {
-                if (((live >> c) & 1u) == 0u) {
-                  cached_empty = cached_empty | (1u << c);
-                  continue;
-                }
-                RESOCT_IN(ResoctSlotInfo) sc = resoct_read_slot(bank + c);
-                uint cls;
-                RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                  cls = resoct_mode_node_class(cached_node, sc, f.node_slot_count, fx.proj[c]);
-                }
-                else {
-                  cls = resoct_node_class(cached_node, sc, f.node_slot_count);
-                }
-                if (cls == RESOCT_NODE_CLASS_INVALID) {
-                  invalid = invalid | (1u << c);
-                  RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
-                    cls = resoct_mode_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
-                                                         f.node_slot_count, fx.proj[c]);
-                  }
-                  else {
-                    cls = resoct_node_class_carried(cached_node, cap_depth, f.start_depth, sc,
-                                                    f.node_slot_count);
-                  }
-                  // A homogeneous ancestor's value is only known at the ancestor: read it there.
-                  if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cls = RESOCT_NODE_CLASS_VISIBLE;
-                }
-                if (cls == RESOCT_NODE_CLASS_EMPTY) cached_empty = cached_empty | (1u << c);
-                if (cls == RESOCT_NODE_CLASS_HOMOGENEOUS) cached_homog = cached_homog | (1u << c);
-              }
-              uint all = n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u);
-              if (cached_empty == all) {
-                cached_skip_depth = cap_depth;
-              } else if ((invalid >> uint(findLSB(~cached_empty))) != 0u &&
-                         cached_node != last_node_request) {
-                // Requested when an INVALID channel is at or after the first channel that is
-                // not empty here: channels before it were settled by their ancestors' records.
-                last_node_request = cached_node;
-                resoct_report_node_request(cached_node);
-                stats.requests = stats.requests + 1u;
-              }
-            } else {
-              RESOCT_IN(ResoctDepthInfo) Dk = resoct_read_depth(cached_skip_depth);
-              cached_node = Dk.first_node + path_local[cached_skip_depth];
-            }
+          // The traversal node of this sample (kernel/residency_descent.glsl.h).
+          if (!resoct_descent_holds(ds, cap_depth, cell)) {
+            RESOCT_FX(resoct_residency_descend)
+            (f, bank, n, live, cap_depth, cell, fx, ds, dp, last_node_request, stats);
           }
-          node = cached_node;
+          node = ds.node;
           // A node's class holds in the node shrunk by the margin (the whole node at level 0);
           // in the rest of it (the rim) every live channel is looked up, and entering the shrunk
           // part is a new decision.
           uint live_mask = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
-          if (cached_skip_depth != RESOCT_NONE_U) {
-            RESOCT_IN(ResoctDepthInfo) Ds = resoct_read_depth(cached_skip_depth);
+          if (ds.skip_depth != RESOCT_NONE_U) {
+            RESOCT_IN(ResoctDepthInfo) Ds = resoct_read_depth(ds.skip_depth);
             ivec3 ne = ivec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
             class_lo = ivec3(resoct_node_coord(Ds, cell)) * ne;
             class_hi = class_lo + ne;
@@ -495,20 +289,20 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                 run = false;
               }
               if (run) {
-                skip_exit = resoct_node_run_end(
-                    f, bank, n, live, RESOCT_NODE_CLASS_EMPTY, cached_skip_depth, cached_node,
-                    resoct_node_coord(Ds, cell), class_lo, cell, frac, dir_vox, inv_vox, skip_exit,
-                    ivec3(-2147483647), ivec3(2147483647), stats);
+                skip_exit = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_EMPTY,
+                                                ds.skip_depth, ds.node, resoct_node_coord(Ds, cell),
+                                                class_lo, cell, frac, dir_vox, inv_vox, skip_exit,
+                                                ivec3(-2147483647), ivec3(2147483647), stats);
               }
             } else {
               node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
                                resoct_box_entry_t(cell, frac, inv_vox, ilo, ihi));
             }
           } else {
-            class_lo = cached_lo;
-            class_hi = cached_hi;
-            class_empty = cached_empty & live_mask;
-            class_homog = cached_homog & live_mask & ~class_empty;
+            class_lo = ds.lo;
+            class_hi = ds.hi;
+            class_empty = ds.empty & live_mask;
+            class_homog = ds.homog & live_mask & ~class_empty;
             ivec3 ilo = class_lo;
             ivec3 ihi = class_hi;
             if ((class_empty | class_homog) != 0u && any(greaterThan(margin, ivec3(0)))) {
@@ -629,14 +423,17 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         // crossing into them is no decision (docs/rendering.md "Segments"). Only where nothing
         // at the node settles a channel (no empty or homogeneous class, no source chosen by the
         // node), and not for projections, whose classes follow the values along the ray.
-        bool merge = mode == RESOCT_MODE_RESIDENCY && !skip && cached_skip_depth == RESOCT_NONE_U &&
-                     cached_full == 0u && class_empty == 0u && class_homog == 0u && !seg_node_dep;
+        bool merge = mode == RESOCT_MODE_RESIDENCY && !skip && ds.skip_depth == RESOCT_NONE_U &&
+                     ds.full == 0u && class_empty == 0u && class_homog == 0u && !seg_node_dep;
+        // A run can only move the next decision when the node ends before the sources do: a
+        // longer node_t_end leaves min(seg_t_end, node_t_end) at seg_t_end (t + x is monotonic).
+        if (merge && !(tm + node_t_end < seg_t_end)) merge = false;
         RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
           merge = false;
         }
         if (merge) {
           node_t_end = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_VISIBLE, cap_depth,
-                                           cached_node, cached_coord, class_lo, cell, frac, dir_vox,
+                                           ds.node, ds.coord, class_lo, cell, frac, dir_vox,
                                            inv_vox, node_t_end, seg_box_lo, seg_box_hi, stats);
         }
         if (!skip) node_t_end = tm + node_t_end;
@@ -767,7 +564,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
     }
     if (stop || segs.enabled == 0u ||
         !resoct_segment_advance(f, segs, o_cell, o_frac, dir_box, dir_vox, dt, t, t_exit, acc, live,
-                                bank, cached_node, cached_coord, stats)) {
+                                bank, ds.node, ds.coord, stats)) {
       break;
     }
     have_seg = false;
