@@ -39,8 +39,8 @@ struct ResoctDescent {
   uint full;
 };
 
-/// The path of a ray's last descent, which the next one reuses. Kept apart from ResoctDescent:
-/// a C++ compiler keeps a record's fields in registers only when it holds no array.
+/// The path of a ray's last descent, which the next one reuses: the descent's own state, which
+/// the march never reads (it reads ResoctDescent).
 struct ResoctDescentPath {
   // Per depth d in [start_depth, end] the node's local index and the channels found empty down
   // to it; skip = 1 when every channel was empty at `end`.
