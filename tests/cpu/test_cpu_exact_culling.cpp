@@ -217,6 +217,52 @@ TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
   }
 }
 
+// A visible node that contains every live channel's target brick computes no exit: its exit is
+// never before the sources' (docs/rendering.md "Nodes that hold the sources"). Nodes smaller than
+// the bricks must still end segments. A 64³ volume of 16³ bricks holds, in each brick, a slab of
+// 200 at x in [0, 4) and zeros elsewhere; the view looks down the x axis. With 4³ leaves, the
+// leaf at x in [8, 12) of each brick is EMPTY (its records cover one voxel around it, all zeros)
+// and follows a visible leaf inside the same brick: residency mode ends the visible leaf's segment
+// and skips the EMPTY one, so it takes 0.67 of the samples of the page table, which samples whole
+// bricks (measured). Treating every visible node as holding the bricks leaves the image alone but
+// takes 0.84 of them (measured): it skips only EMPTY leaves in which a brick's segment begins. With
+// 16³ and 32³ leaves every node holds the bricks and none is EMPTY: the page table's samples.
+TEST(ExactCulling, OnlyNodesThatHoldTheBricksEndNoSegment) {
+  VolumeDesc v;
+  v.extent = {64, 64, 64};
+  v.type = VoxelType::u8;
+  BrickLayout bricks;
+  bricks.brick_size = glm::uvec3(16);
+  bricks.halo = 1;
+  FunctionSource src(
+      v, bricks, [](std::uint32_t, const glm::u64vec3& p) { return p.x % 16u < 4u ? 200.0 : 0.0; });
+  Scene s = make_scene(64);
+  s.channels = {make_channel(0,
+                             {{0.0, {1, 1, 1, 0}},
+                              {0.3, {1, 1, 1, 0}},
+                              {0.5, {1, 0.6, 0.2, 0.02}},
+                              {1.0, {1, 1, 1, 0.05}}},
+                             0, 0)};
+  FrameOptions o;
+  for (std::uint32_t leaf : {4u, 16u, 32u}) {
+    ResidentOptions ro;
+    ro.leaf_size = glm::uvec3(leaf);
+    ResidentScene rs(src, {0}, ro);
+    const std::string what = "leaf " + std::to_string(leaf);
+    o.mode = RenderMode::pagetable;
+    const Rendered pt = render_cpu(rs, s, o);
+    o.mode = RenderMode::residency;
+    const Rendered res = render_cpu(rs, s, o);
+    ASSERT_GT(res.stats.samples, 0u) << what;
+    EXPECT_LT(max_diff(res.image, pt.image), 2e-4) << what;
+    if (leaf == 4u) {
+      EXPECT_LT(double(res.stats.samples), 0.75 * double(pt.stats.samples)) << what;
+    } else {
+      EXPECT_EQ(res.stats.samples, pt.stats.samples) << what;
+    }
+  }
+}
+
 // A voxel checkerboard of 10 and 240 under a transfer function that hides [0, 0.1]: every node's
 // range [10, 240] holds hidden values, so no record proves its node wholly visible
 // (resoct_node_full), yet no node is EMPTY. The frame's visible-subtree bits (built on the host

@@ -33,10 +33,11 @@ struct ResoctDescent {
   // The depth of the node at which every live channel was empty (RESOCT_NONE_U: none): the
   // sample lies in an empty node of that depth.
   uint skip_depth;
-  // 1 when `node` is an ancestor of the traversal node at which the descent stopped because no
-  // node below it can be EMPTY for a live channel (resoct_node_full): then its whole box is one
-  // visible node, with no descent, classification or run inside it.
-  uint full;
+  // The depth of `node` when it is an ancestor of the traversal node at which the descent
+  // stopped because no node below it can be EMPTY for a live channel (resoct_node_full); then
+  // its whole box is one visible node, with no descent, classification or run inside it.
+  // RESOCT_NONE_U: the descent reached the traversal node.
+  uint full_depth;
 };
 
 /// The path of a ray's last descent, which the next one reuses: the descent's own state, which
@@ -60,7 +61,7 @@ RESOCT_FN void resoct_descent_clear(RESOCT_OUT(ResoctDescent) ds,
   ds.empty = 0u;
   ds.homog = 0u;
   ds.skip_depth = RESOCT_NONE_U;
-  ds.full = 0u;
+  ds.full_depth = RESOCT_NONE_U;
   dp.end = RESOCT_NONE_U;
   dp.skip = 0u;
 }
@@ -114,7 +115,7 @@ RESOCT_FX_FN void resoct_residency_descend(RESOCT_FRAME_IN f, uint bank, uint n,
   ds.depth = cap_depth;
   ds.homog = 0u;
   ds.skip_depth = RESOCT_NONE_U;
-  ds.full = 0u;
+  ds.full_depth = RESOCT_NONE_U;
   uint full_depth = RESOCT_NONE_U;
   uint state = 0u;
   uint local = 0u;
@@ -222,7 +223,7 @@ RESOCT_FX_FN void resoct_residency_descend(RESOCT_FRAME_IN f, uint bank, uint n,
     uvec3 fne = uvec3(Df.node_extent_x, Df.node_extent_y, Df.node_extent_z);
     ds.lo = ivec3(resoct_ancestor_coord(Df, trav_coord, trav_log2) * fne);
     ds.hi = ds.lo + ivec3(fne);
-    ds.full = 1u;
+    ds.full_depth = full_depth;
   } else if (ds.skip_depth == RESOCT_NONE_U) {
     // The remaining channels at the traversal node. A node whose own record is INVALID
     // is requested; its class is carried down from the nearest ancestor with metadata

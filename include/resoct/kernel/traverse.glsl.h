@@ -60,6 +60,21 @@
 
 RESOCT_KERNEL_BEGIN
 
+/// 1 + the deepest octree depth whose nodes are unions of level L's bricks (each node contains
+/// the brick of L at any position inside it); 0 when no depth's are. Nodes and bricks both start
+/// at voxel 0, so a node is such a union when its extent is a multiple of the brick's (in level-0
+/// voxels); node extents halve or stay from one depth to the next, so these depths are a prefix.
+RESOCT_FN uint resoct_brick_depth_end(RESOCT_FRAME_IN f, RESOCT_IN(ResoctLevelInfo) L,
+                                      uvec3 brick_size) {
+  if (L.node_depth != RESOCT_NONE_U) return L.node_depth + 1u;  // its nodes are the bricks
+  // Else no depth's nodes equal the bricks: if the deepest depth's nodes are unions of them,
+  // every depth's are.
+  RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(f.depth_count - 1u);
+  uvec3 brick0 = brick_size << resoct_level_factor(L);
+  uvec3 ne = uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
+  return all(equal(ne % brick0, uvec3(0u))) ? f.depth_count : 0u;
+}
+
 RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.samples = 0u;
   st.nodes = 0u;
@@ -132,6 +147,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
   // The traversal depth capped for the LOD level cap_lod (RESOCT_NONE_U: not computed yet).
   uint cap_lod = RESOCT_NONE_U;
   uint cap_depth = trav_depth;
+  // The least resoct_brick_depth_end of the live channels' levels at cap_lod: a node shallower
+  // than this contains every channel's target brick at any position inside it.
+  uint brick_depth_end = 0u;
 
   // Effects: per-ray state and constants (only touched by specializations that use them).
   ResoctFxRay fx;
@@ -250,14 +268,21 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             cap_lod = lod;
             uint cap_level = RESOCT_NONE_U;
             uvec3 coarse_f = uvec3(0u);
+            brick_depth_end = RESOCT_NONE_U;
             for (uint c = 0u; c < n; ++c) {
               if (((live >> c) & 1u) == 0u) continue;
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint lc = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               cap_level = min(cap_level, lc);
-              coarse_f = max(coarse_f, resoct_level_factor(resoct_read_level(lc)));
+              RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(lc);
+              coarse_f = max(coarse_f, resoct_level_factor(Lc));
+              brick_depth_end =
+                  min(brick_depth_end, resoct_brick_depth_end(f, Lc, resoct_frame_brick_size(sp)));
             }
-            if (cap_level == RESOCT_NONE_U) cap_level = lod;
+            if (cap_level == RESOCT_NONE_U) {
+              cap_level = lod;
+              brick_depth_end = 0u;
+            }
             cap_depth = min(trav_depth, resoct_level_depth_cap(
                                             f.start_depth, f.depth_count,
                                             resoct_level_factor(resoct_read_level(cap_level))));
@@ -303,19 +328,27 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             class_hi = ds.hi;
             class_empty = ds.empty & live_mask;
             class_homog = ds.homog & live_mask & ~class_empty;
-            ivec3 ilo = class_lo;
-            ivec3 ihi = class_hi;
-            if ((class_empty | class_homog) != 0u && any(greaterThan(margin, ivec3(0)))) {
-              ilo = ilo + margin;
-              ihi = ihi - margin;
-            }
-            if (resoct_in_box(cell, ilo, ihi)) {
-              node_t_end = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
-            } else {
-              class_empty = 0u;
-              class_homog = 0u;
-              node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
-                               resoct_box_entry_t(cell, frac, inv_vox, ilo, ihi));
+            // A node (the traversal node or a visible ancestor) that settles no channel and
+            // contains every live channel's target brick: each source box lies inside it (a
+            // substitute's is clipped to it), so the node ends no earlier than the sources and
+            // its exit cannot be the next decision; node_t_end stays infinite.
+            bool holds_sources =
+                (class_empty | class_homog) == 0u && min(ds.full_depth, ds.depth) < brick_depth_end;
+            if (!holds_sources) {
+              ivec3 ilo = class_lo;
+              ivec3 ihi = class_hi;
+              if ((class_empty | class_homog) != 0u && any(greaterThan(margin, ivec3(0)))) {
+                ilo = ilo + margin;
+                ihi = ihi - margin;
+              }
+              if (resoct_in_box(cell, ilo, ihi)) {
+                node_t_end = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
+              } else {
+                class_empty = 0u;
+                class_homog = 0u;
+                node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
+                                 resoct_box_entry_t(cell, frac, inv_vox, ilo, ihi));
+              }
             }
           }
           // Sources stay while they hold (their bricks, the LOD level) unless the classes
@@ -424,7 +457,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         // at the node settles a channel (no empty or homogeneous class, no source chosen by the
         // node), and not for projections, whose classes follow the values along the ray.
         bool merge = mode == RESOCT_MODE_RESIDENCY && !skip && ds.skip_depth == RESOCT_NONE_U &&
-                     ds.full == 0u && class_empty == 0u && class_homog == 0u && !seg_node_dep;
+                     ds.full_depth == RESOCT_NONE_U && class_empty == 0u && class_homog == 0u &&
+                     !seg_node_dep;
         // A run can only move the next decision when the node ends before the sources do: a
         // longer node_t_end leaves min(seg_t_end, node_t_end) at seg_t_end (t + x is monotonic).
         if (merge && !(tm + node_t_end < seg_t_end)) merge = false;
