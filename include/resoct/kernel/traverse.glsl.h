@@ -60,21 +60,6 @@
 
 RESOCT_KERNEL_BEGIN
 
-/// 1 + the deepest octree depth whose nodes are unions of level L's bricks (each node contains
-/// the brick of L at any position inside it); 0 when no depth's are. Nodes and bricks both start
-/// at voxel 0, so a node is such a union when its extent is a multiple of the brick's (in level-0
-/// voxels); node extents halve or stay from one depth to the next, so these depths are a prefix.
-RESOCT_FN uint resoct_brick_depth_end(RESOCT_FRAME_IN f, RESOCT_IN(ResoctLevelInfo) L,
-                                      uvec3 brick_size) {
-  if (L.node_depth != RESOCT_NONE_U) return L.node_depth + 1u;  // its nodes are the bricks
-  // Else no depth's nodes equal the bricks: if the deepest depth's nodes are unions of them,
-  // every depth's are.
-  RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(f.depth_count - 1u);
-  uvec3 brick0 = brick_size << resoct_level_factor(L);
-  uvec3 ne = uvec3(D.node_extent_x, D.node_extent_y, D.node_extent_z);
-  return all(equal(ne % brick0, uvec3(0u))) ? f.depth_count : 0u;
-}
-
 RESOCT_FN void resoct_stats_clear(RESOCT_OUT(ResoctRayStats) st) {
   st.samples = 0u;
   st.nodes = 0u;
