@@ -24,15 +24,19 @@
 //         3..7 the Table 1 datasets of bench_table1, one channel: tubes, noisefloor, turbulence,
 //         mandelbulb (256³ u8) and cells channel 0 (512×512×40 u16), bench_tf, orbit camera at
 //         angle 0, 256²
-//     i = 0 dense march, 1 backend residency mode, 2 backend page-table mode (run in this order
-//         per scene, so the backend rows report their ratios against the dense row)
+//     i = 0 dense march, 3 oracle culling (the dense march's visible samples alone, recorded in an
+//         untimed pass: the per-ray set-up and the samples that add colour, nothing spent on
+//         finding them; its image must equal the dense image bit for bit), 1 backend residency
+//         mode, 2 backend page-table mode (run in this order per scene, so the backend rows
+//         report their ratios against the dense and oracle rows)
 // One benchmark iteration = one frame. Threads: 2 (RESOCT_LIMIT_THREADS=N to change), for both.
 // Counters (per frame): ms_frame (wall), cpu_ms_frame (CPU time of the whole process: all render
 // threads), samples (dense: segments evaluated; backend: samples that produced a value — skipped
 // segments are not samples), samples_per_ray, ns_sample_core (CPU ns per sample: per core),
 // ns_sample_wall_core (wall ns × threads per sample); dense rows: visible_per_ray (samples with TF
 // alpha > 0); backend rows: iterations_per_ray (segments including skipped ones), nodes_per_ray,
-// over_dense_wall / over_dense_cpu (backend ms / dense ms, wall and CPU), dense_samples_ratio
+// over_dense_wall / over_dense_cpu (backend ms / dense ms, wall and CPU), over_oracle_cpu (backend
+// CPU ms / oracle CPU ms; oracle rows: over_dense_cpu as well), dense_samples_ratio
 // (backend samples / dense samples), max_diff_255 / mean_diff_255 (largest and mean absolute RGB
 // difference of the backend image from the dense image, in 1/255 units; the mean is over all
 // pixels and colour components; a row whose difference exceeds 4/255 is reported as an error).
@@ -72,7 +76,8 @@ using namespace resoct::bench;
 
 constexpr const char* kSceneNames[] = {"sphere",     "sphere_noskip", "ramp_noskip", "tubes",
                                        "noisefloor", "turbulence",    "mandelbulb",  "cells"};
-constexpr const char* kImplNames[] = {"dense", "residency", "pagetable"};
+constexpr const char* kImplNames[] = {"dense", "residency", "pagetable", "oracle"};
+constexpr int kOracle = 3;
 constexpr int kScenes = 8;
 constexpr int kFirstTable1 = 3;
 // Largest image difference accepted (1/255 units). Float rounding alone stays below 0.01; a ray
@@ -166,7 +171,8 @@ struct Case {
   Scene sc;
   FrameTables tables[3];
   Image dense_image;
-  double max_diff[3] = {0, 0, 0}, mean_diff[3] = {0, 0, 0};
+  VisibleSamples visible;  // the oracle's samples: the dense march's visible ones
+  double max_diff[4] = {0, 0, 0, 0}, mean_diff[4] = {0, 0, 0, 0};
   std::map<int, ImplResult> done;
 };
 
@@ -209,6 +215,12 @@ Case& case_for(int scene) {
   o.mode = RenderMode::pagetable;
   c.tables[2] = c.rig->resident->tables(c.sc, o);
   c.dense->render(c.dense_image, threads);
+  c.visible = c.dense->record_visible(threads);
+  {
+    Image oracle;
+    c.dense->render_visible(oracle, c.visible, threads);
+    image_diff(oracle, c.dense_image, c.max_diff[kOracle], c.mean_diff[kOracle]);
+  }
   const char* out = std::getenv("RESOCT_LIMIT_OUT");
   const std::string dir = out != nullptr ? out : "";
   const auto png = [&](int impl, const Image& img) {
@@ -255,13 +267,16 @@ void BM_Limit(benchmark::State& state) {
   // One untimed frame (faults in the image and, for the backend, its request buffers).
   if (impl == 0) {
     c.dense->render(image, threads);
+  } else if (impl == kOracle) {
+    c.dense->render_visible(image, c.visible, threads);
   } else {
     c.rig->backend->render(c.tables[impl], result);
   }
   for (auto _ : state) {
     const double w0 = wall_ms(), c0 = process_cpu_ms();
-    if (impl == 0) {
-      const DenseStats st = c.dense->render(image, threads);
+    if (impl == 0 || impl == kOracle) {
+      const DenseStats st = impl == 0 ? c.dense->render(image, threads)
+                                      : c.dense->render_visible(image, c.visible, threads);
       const double c1 = process_cpu_ms(), w1 = wall_ms();
       wall += w1 - w0;
       cpu += c1 - c0;
@@ -297,6 +312,17 @@ void BM_Limit(benchmark::State& state) {
       r.samples > 0 ? r.wall_ms * 1e6 * double(threads) / r.samples : 0.0;
   if (impl == 0) {
     state.counters["visible_per_ray"] = visible / rays;
+  } else if (impl == kOracle) {
+    // Bit for bit: the oracle composites exactly the dense march's visible samples.
+    if (c.max_diff[kOracle] != 0.0) {
+      state.SkipWithError(("the oracle's image differs from the dense march's by " +
+                           std::to_string(c.max_diff[kOracle] * 255.0) + "/255")
+                              .c_str());
+    }
+    if (const auto d = c.done.find(0); d != c.done.end()) {
+      state.counters["over_dense_wall"] = r.wall_ms / d->second.wall_ms;
+      state.counters["over_dense_cpu"] = r.cpu_ms / d->second.cpu_ms;
+    }
   } else {
     state.counters["iterations_per_ray"] = iterations / rays;
     state.counters["nodes_per_ray"] = nodes / rays;
@@ -312,6 +338,9 @@ void BM_Limit(benchmark::State& state) {
       state.counters["over_dense_cpu"] = r.cpu_ms / d->second.cpu_ms;
       state.counters["dense_samples_ratio"] = r.samples / d->second.samples;
     }
+    if (const auto o = c.done.find(kOracle); o != c.done.end()) {
+      state.counters["over_oracle_cpu"] = r.cpu_ms / o->second.cpu_ms;
+    }
   }
   state.SetItemsProcessed(std::int64_t(rays));
   state.SetLabel(std::string(kSceneNames[scene]) + "/" + kImplNames[impl]);
@@ -320,7 +349,7 @@ void BM_Limit(benchmark::State& state) {
 BENCHMARK(BM_Limit)
     ->Apply([](benchmark::internal::Benchmark* b) {
       for (int s = 0; s < kScenes; ++s) {
-        for (int impl = 0; impl < 3; ++impl) b->Args({s, impl});
+        for (const int impl : {0, kOracle, 1, 2}) b->Args({s, impl});
       }
     })
     ->ArgNames({"scene", "impl"})

@@ -90,12 +90,19 @@ struct Setup {
   std::size_t row, plane;  // strides of the padded array (elements)
 };
 
-// One pixel: the premultiplied colour over the background.
-template <class T>
+// What march_pixel does with the samples: marches every segment (the dense march), marches every
+// segment and keeps the visible ones (record_visible), or evaluates only kept ones (the
+// oracle-culling bound, render_visible).
+enum class Pass { dense, record, replay };
+
+// One pixel: the premultiplied colour over the background. Pass::record appends the ray's
+// visible samples to `kept`; Pass::replay evaluates `replay` instead of marching.
+template <class T, Pass kPass>
 [[gnu::always_inline]] inline glm::vec4 march_pixel(const Setup& s, const std::byte* vox,
                                                     std::uint32_t px, std::uint32_t py,
-                                                    std::uint64_t& samples,
-                                                    std::uint64_t& visible) {
+                                                    std::uint64_t& samples, std::uint64_t& visible,
+                                                    std::vector<VisibleSample>* kept,
+                                                    std::span<const VisibleSample> replay) {
   const DenseMarch::Frame& f = *s.f;
   glm::vec4 acc(0.0f);
   const glm::vec4 bg = f.background;
@@ -215,6 +222,23 @@ template <class T>
     acc = acc + (1.0f - acc.a) * glm::vec4(rgb * op, op);
     return acc.a >= ert;
   };
+  if constexpr (kPass == Pass::replay) {
+    // The kept samples alone, each as the march below evaluated it.
+    for (const VisibleSample& k : replay) {
+      ++n;
+      const bool from_level = k.ratio < 0.0f;
+      if (sample(k.tm, from_level ? ratio_full : k.ratio, from_level ? level_lut : nullptr)) break;
+    }
+    samples += n;
+    visible += nv;
+    return acc + (1.0f - acc.a) * bg_premul;
+  }
+  // Pass::record: the sample at tm is kept when it added colour.
+  const auto keep = [&](std::uint64_t nv_before, float tm, float ratio, bool from_level) {
+    if constexpr (kPass == Pass::record) {
+      if (nv != nv_before) kept->push_back({tm, from_level ? -1.0f : ratio});
+    }
+  };
   // Whole steps [t, t + dt) while they fit, then the shorter last segment(s), corrected for
   // their length (resoct_segment_length). Step j starts at t_grid + j * dt, each operation
   // rounded once (resoct_grid_t), at least one ulp past the previous start.
@@ -235,7 +259,10 @@ template <class T>
   bool saturated = false;
   while (t_exit - t >= dt) {
     ++n;
-    if (sample(t + half_dt, ratio_full, level_lut)) {
+    const std::uint64_t nv_before = nv;
+    const bool done = sample(t + half_dt, ratio_full, level_lut);
+    keep(nv_before, t + half_dt, ratio_full, level_lut != nullptr);
+    if (done) {
       saturated = true;
       break;
     }
@@ -244,7 +271,11 @@ template <class T>
   while (!saturated && t_exit - t > end_eps) {
     ++n;
     const float seg = std::max(std::min(dt, t_exit - t), 0.0f);
-    if (sample(t + 0.5f * seg, seg * (1.0f / f.ref_step), seg == dt ? level_lut : nullptr)) break;
+    const glm::vec4* corrected = seg == dt ? level_lut : nullptr;
+    const std::uint64_t nv_before = nv;
+    const bool done = sample(t + 0.5f * seg, seg * (1.0f / f.ref_step), corrected);
+    keep(nv_before, t + 0.5f * seg, seg * (1.0f / f.ref_step), corrected != nullptr);
+    if (done) break;
     t = next_t(t);
   }
   samples += n;
@@ -252,8 +283,10 @@ template <class T>
   return acc + (1.0f - acc.a) * bg_premul;
 }
 
-template <class T>
-DenseStats render_typed(const Setup& s, const std::byte* vox, glm::vec4* pixels, int threads) {
+template <class T, Pass kPass = Pass::dense>
+DenseStats render_typed(const Setup& s, const std::byte* vox, glm::vec4* pixels, int threads,
+                        std::vector<std::vector<VisibleSample>>* kept = nullptr,
+                        const VisibleSamples* replay = nullptr) {
   const DenseMarch::Frame& f = *s.f;
   const std::uint32_t tiles_x = (f.width + kTile - 1) / kTile;
   const std::uint32_t tiles_y = (f.height + kTile - 1) / kTile;
@@ -267,7 +300,15 @@ DenseStats render_typed(const Setup& s, const std::byte* vox, glm::vec4* pixels,
     const std::uint32_t y1 = std::min(ty + kTile, f.height);
     for (std::uint32_t y = ty; y < y1; ++y) {
       for (std::uint32_t x = tx; x < x1; ++x) {
-        const glm::vec4 p = march_pixel<T>(s, vox, x, y, samples, visible);
+        const std::size_t ray = std::size_t(y) * f.width + x;
+        std::span<const VisibleSample> mine;
+        if constexpr (kPass == Pass::replay) {
+          mine =
+              std::span<const VisibleSample>(replay->samples)
+                  .subspan(replay->offsets[ray], replay->offsets[ray + 1] - replay->offsets[ray]);
+        }
+        const glm::vec4 p = march_pixel<T, kPass>(
+            s, vox, x, y, samples, visible, kPass == Pass::record ? &(*kept)[ray] : nullptr, mine);
         pixels[std::size_t(y) * f.width + x] =
             p.a > 0.0f ? glm::vec4(glm::vec3(p) / p.a, p.a) : glm::vec4(0.0f);
       }
@@ -423,25 +464,80 @@ DenseMarch::DenseMarch(const DenseVolume& volume, const Scene& scene) : volume_(
   }
 }
 
+namespace {
+
+// render_typed for the volume's voxel type.
+template <Pass kPass>
+DenseStats render_pass(const DenseVolume& volume, const Setup& s, glm::vec4* px, int threads,
+                       std::vector<std::vector<VisibleSample>>* kept,
+                       const VisibleSamples* replay) {
+  const std::byte* data = volume.voxels.data();
+  switch (volume.volume.type) {
+    case VoxelType::u8:
+      return render_typed<std::uint8_t, kPass>(s, data, px, threads, kept, replay);
+    case VoxelType::u16:
+      return render_typed<std::uint16_t, kPass>(s, data, px, threads, kept, replay);
+    case VoxelType::f32: return render_typed<float, kPass>(s, data, px, threads, kept, replay);
+  }
+  return {};
+}
+
+Setup make_setup(const DenseMarch::Frame& f, const std::vector<glm::vec4>& lut,
+                 const std::vector<glm::vec4>& level_luts, const StepLevels& levels,
+                 const DenseVolume& volume) {
+  Setup s{};
+  s.f = &f;
+  s.lut = lut.data();
+  s.level_luts = level_luts.data();
+  s.levels = levels;
+  s.row = volume.padded.x;
+  s.plane = std::size_t(volume.padded.x) * volume.padded.y;
+  return s;
+}
+
+}  // namespace
+
 DenseStats DenseMarch::render(Image& image, int threads) const {
   const Frame& f = frame_;
   if (image.width() != f.width || image.height() != f.height) image = Image(f.width, f.height);
   const int n = threads > 0 ? threads : omp_get_max_threads();
-  Setup s{};
-  s.f = &f;
-  s.lut = lut_.data();
-  s.level_luts = level_luts_.data();
-  s.levels = levels_;
-  s.row = volume_.padded.x;
-  s.plane = std::size_t(volume_.padded.x) * volume_.padded.y;
-  glm::vec4* px = image.pixels().data();
-  const std::byte* data = volume_.voxels.data();
-  switch (volume_.volume.type) {
-    case VoxelType::u8: return render_typed<std::uint8_t>(s, data, px, n);
-    case VoxelType::u16: return render_typed<std::uint16_t>(s, data, px, n);
-    case VoxelType::f32: return render_typed<float>(s, data, px, n);
+  return render_pass<Pass::dense>(volume_, make_setup(f, lut_, level_luts_, levels_, volume_),
+                                  image.pixels().data(), n, nullptr, nullptr);
+}
+
+VisibleSamples DenseMarch::record_visible(int threads) const {
+  const Frame& f = frame_;
+  const int n = threads > 0 ? threads : omp_get_max_threads();
+  Image image(f.width, f.height);
+  std::vector<std::vector<VisibleSample>> kept(std::size_t(f.width) * f.height);
+  render_pass<Pass::record>(volume_, make_setup(f, lut_, level_luts_, levels_, volume_),
+                            image.pixels().data(), n, &kept, nullptr);
+  VisibleSamples v;
+  v.width = f.width;
+  v.height = f.height;
+  v.offsets.reserve(kept.size() + 1);
+  v.offsets.push_back(0);
+  for (const auto& k : kept) v.offsets.push_back(v.offsets.back() + k.size());
+  v.samples.reserve(v.offsets.back());
+  for (const auto& k : kept) v.samples.insert(v.samples.end(), k.begin(), k.end());
+  return v;
+}
+
+DenseStats DenseMarch::render_visible(Image& image, const VisibleSamples& visible,
+                                      int threads) const {
+  const Frame& f = frame_;
+  if (visible.width != f.width || visible.height != f.height ||
+      visible.offsets.size() != std::size_t(f.width) * f.height + 1 ||
+      visible.offsets.back() != visible.samples.size()) {
+    throw invalid_parameter("visible", "recorded for a " + std::to_string(visible.width) + "x" +
+                                           std::to_string(visible.height) +
+                                           " frame, not this march's " + std::to_string(f.width) +
+                                           "x" + std::to_string(f.height));
   }
-  return {};
+  if (image.width() != f.width || image.height() != f.height) image = Image(f.width, f.height);
+  const int n = threads > 0 ? threads : omp_get_max_threads();
+  return render_pass<Pass::replay>(volume_, make_setup(f, lut_, level_luts_, levels_, volume_),
+                                   image.pixels().data(), n, nullptr, &visible);
 }
 
 }  // namespace resoct::bench

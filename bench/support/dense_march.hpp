@@ -63,6 +63,23 @@ struct DenseStats {
   std::uint64_t visible_samples = 0;  ///< of those, samples with TF alpha > 0 (composited)
 };
 
+/// One composited sample of a ray: its midpoint and its length in reference steps; a negative
+/// `ratio` marks a full step of the ray's step level, whose colour comes from that level's
+/// opacity-corrected LUT.
+struct VisibleSample {
+  float tm = 0.0f;
+  float ratio = 0.0f;
+};
+
+/// The samples of a frame that a renderer with perfect culling at no cost would compute: per ray,
+/// those whose transfer-function alpha is above zero, up to early termination. Ray p (pixel
+/// y · width + x) owns samples[offsets[p], offsets[p + 1]).
+struct VisibleSamples {
+  std::uint32_t width = 0, height = 0;
+  std::vector<std::uint64_t> offsets;
+  std::vector<VisibleSample> samples;
+};
+
 /// A scene prepared for one dense volume: frame and per-channel constants computed once.
 /// Immutable after construction; render() may run concurrently with itself on other images.
 class DenseMarch {
@@ -77,6 +94,18 @@ class DenseMarch {
   /// Renders the scene into `image` (resized to the viewport; straight alpha like
   /// FrameResult::image) on `threads` OpenMP threads (<= 0: all).
   DenseStats render(Image& image, int threads) const;
+
+  /// The visible samples of every ray of render() (an untimed pass of the dense march that keeps
+  /// them).
+  VisibleSamples record_visible(int threads) const;
+
+  /// The oracle-culling bound: renders only `visible` (record_visible of this march): the per-ray
+  /// set-up, then exactly the samples that add colour, with the dense march's arithmetic, so the
+  /// image equals render()'s bit for bit (a transparent sample adds nothing), while no sample,
+  /// node or brick is spent on finding them. No exact renderer with this per-ray definition can
+  /// sample less. DenseStats::samples counts the samples evaluated (= visible_samples). Throws
+  /// Error(invalid_argument) naming "visible" when it was recorded for another viewport.
+  DenseStats render_visible(Image& image, const VisibleSamples& visible, int threads) const;
 
   /// Constants of one frame, as the kernel's frame record holds them (floats).
   struct Frame {

@@ -187,9 +187,12 @@ inline void resoct_mark_used(uint cache_slot) {
 
 }  // namespace resoct::kernel
 
-// The march's single-channel segment loop as packets of four or eight samples (same arithmetic).
+// The march's segment loops as packets of four or eight samples (same arithmetic): one value
+// channel, and several.
 #include "segment_packets_avx2.hpp"
+#include "segment_packets_multi.hpp"
 #define RESOCT_SEGMENT_SAMPLES ::resoct::cpu::detail::segment_samples_packets
+#define RESOCT_SEGMENT_SAMPLES_MULTI ::resoct::cpu::detail::segment_samples_multi_packets
 #include "resoct/kernel/traverse.glsl.h"
 
 namespace resoct::cpu::detail {

@@ -206,12 +206,14 @@ template <int N>
 // Composites the packet's samples in order with the early-termination test after each, as the
 // scalar loop does, and moves the state past them. Returns true when the loop is over
 // (saturated, or the schedule ends).
+// Each sample counts `accesses` brick accesses (its mapped channels).
 template <int N>
-[[gnu::always_inline]] inline bool composite_lanes(const kernel::ResoctFrame& f, bool mapped,
-                                                   const v4f* pm, const PacketSchedule<N>& sc,
+[[gnu::always_inline]] inline bool composite_lanes(const kernel::ResoctFrame& f,
+                                                   std::uint32_t accesses, const v4f* pm,
+                                                   const PacketSchedule<N>& sc,
                                                    PacketLoopState& s) {
   for (int l = 0; l < sc.m; ++l) {
-    if (mapped) ++s.accesses;
+    s.accesses += accesses;
     ++s.samples;
     s.a = s.a + splat(1.0f - s.a[3]) * pm[l];
     if (s.a[3] >= f.ert_opacity) {
@@ -294,7 +296,7 @@ inline const glm::vec4* level_lut_of(const KernelContext& ctx, const kernel::Res
       pm[l] =
           lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
     }
-    if (composite_lanes(f, mapped, pm, sc, s)) break;
+    if (composite_lanes(f, mapped ? 1u : 0u, pm, sc, s)) break;
   }
   return packet_loop_end(s, grid_j, t, acc, stats);
 }

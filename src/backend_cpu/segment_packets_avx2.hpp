@@ -119,6 +119,49 @@ template <class T>
   return c0 + fz * (c1 - c0);
 }
 
+// The schedule of an eight-lane packet (lanes from 1 on; lane 0 is set): the scalar loop's
+// control, computed for all lanes at once where the grid's steps strictly increase.
+[[gnu::target("avx2"), gnu::always_inline]] inline void schedule8(const kernel::ResoctFrame& f,
+                                                                  float dt, float t_exit,
+                                                                  float seg_next, float t_grid,
+                                                                  const PacketLoopState& s,
+                                                                  PacketSchedule<8>& sc) {
+  using namespace kernel;
+  const float eps_dt = RESOCT_SEGMENT_EPS * dt;
+  const v8f lane_index{1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f, 8.0f};
+  // Steps j + 1 .. j + 8 at once (resoct_grid_t: float(j + k) * dt, then + t_grid; j + 8 is
+  // exact in float far beyond any iteration cap). Where they do not strictly increase (steps
+  // below an ulp of t), resoct_grid_t's guard decides: the scalar schedule runs.
+  const v8f starts = splat8(t_grid) + (splat8(float(s.j)) + lane_index) * splat8(dt);
+  bool increasing = starts[0] > s.t_now && float(s.j) + 8.0f < 16777216.0f;
+  for (int k = 1; k < 8; ++k) increasing = increasing && starts[k] > starts[k - 1];
+  if (increasing) {
+    // resoct_segment_length: max(min(dt, t_exit - t), 0) with GLM's min (y < x ? y : x) and
+    // max (x < y ? y : x).
+    const v8f rest = splat8(t_exit) - starts;
+    const v8f segs = select8(rest < splat8(dt), rest, splat8(dt));
+    const v8f seg_len = select8(segs < splat8(0.0f), splat8(0.0f), segs);
+    const v8f mids = starts + splat8(0.5f) * seg_len;
+    for (int k = 1; k <= 8; ++k) {
+      sc.t_after = starts[k - 1];
+      if (!(t_exit - sc.t_after > eps_dt) ||
+          s.iterations + std::uint32_t(k - 1) >= f.max_iterations || !(mids[k - 1] < seg_next)) {
+        sc.ends = true;
+        break;
+      }
+      sc.next_seg = seg_len[k - 1];
+      sc.next_tm = mids[k - 1];
+      if (k == 8) break;
+      sc.lane_tm[k] = sc.next_tm;
+      sc.lane_seg[k] = sc.next_seg;
+      sc.lane_t[k] = sc.t_after;
+      sc.m = k + 1;
+    }
+  } else {
+    schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
+  }
+}
+
 // The loop in packets of eight, with kernel::resoct_segment_samples' contract.
 [[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
     const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
@@ -135,45 +178,13 @@ template <class T>
   const std::byte* brick =
       mapped ? ctx.cache + std::size_t(src.cache_slot) * ctx.brick_bytes : nullptr;
   const glm::vec4* level_lut = level_lut_of(ctx, f, src, step_level);
-  const float eps_dt = RESOCT_SEGMENT_EPS * dt;
-  const v8f lane_index{1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f, 8.0f};
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
     PacketSchedule<8> sc;
     sc.lane_tm[0] = s.tm;
     sc.lane_seg[0] = s.seg;
     sc.lane_t[0] = s.t_now;
-    // Steps j + 1 .. j + 8 at once (resoct_grid_t: float(j + k) * dt, then + t_grid; j + 8 is
-    // exact in float far beyond any iteration cap). Where they do not strictly increase (steps
-    // below an ulp of t), resoct_grid_t's guard decides: the scalar schedule runs.
-    const v8f starts = splat8(t_grid) + (splat8(float(s.j)) + lane_index) * splat8(dt);
-    bool increasing = starts[0] > s.t_now && float(s.j) + 8.0f < 16777216.0f;
-    for (int k = 1; k < 8; ++k) increasing = increasing && starts[k] > starts[k - 1];
-    if (increasing) {
-      // resoct_segment_length: max(min(dt, t_exit - t), 0) with GLM's min (y < x ? y : x) and
-      // max (x < y ? y : x).
-      const v8f rest = splat8(t_exit) - starts;
-      const v8f segs = select8(rest < splat8(dt), rest, splat8(dt));
-      const v8f seg_len = select8(segs < splat8(0.0f), splat8(0.0f), segs);
-      const v8f mids = starts + splat8(0.5f) * seg_len;
-      for (int k = 1; k <= 8; ++k) {
-        sc.t_after = starts[k - 1];
-        if (!(t_exit - sc.t_after > eps_dt) ||
-            s.iterations + std::uint32_t(k - 1) >= f.max_iterations || !(mids[k - 1] < seg_next)) {
-          sc.ends = true;
-          break;
-        }
-        sc.next_seg = seg_len[k - 1];
-        sc.next_tm = mids[k - 1];
-        if (k == 8) break;
-        sc.lane_tm[k] = sc.next_tm;
-        sc.lane_seg[k] = sc.next_seg;
-        sc.lane_t[k] = sc.t_after;
-        sc.m = k + 1;
-      }
-    } else {
-      schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
-    }
+    schedule8(f, dt, t_exit, seg_next, t_grid, s, sc);
     // Unused lanes repeat lane 0, so that their reads stay inside the brick.
     for (int l = sc.m; l < 8; ++l) {
       sc.lane_tm[l] = sc.lane_tm[0];
@@ -210,7 +221,7 @@ template <class T>
       pm[l] =
           lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
     }
-    if (composite_lanes(f, mapped, pm, sc, s)) break;
+    if (composite_lanes(f, mapped ? 1u : 0u, pm, sc, s)) break;
   }
   return packet_loop_end(s, grid_j, t, acc, stats);
 }

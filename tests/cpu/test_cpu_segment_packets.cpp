@@ -5,6 +5,9 @@
 // both must return bit-identical results: saturation, t, the accumulated colour and every
 // statistic, for each compiled copy of the packet loop (baseline and, on x86-64 CPUs that have
 // it, AVX2). A difference of one ulp anywhere would make images depend on the backend's loop.
+// The same for the loop of segments with several value channels
+// (src/backend_cpu/segment_packets_multi.hpp) against the march's per-sample pass
+// (kernel::resoct_segment_samples_multi).
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -200,6 +203,107 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
   return saturated;
 }
 
+using MultiLoop = bool (*)(const k::ResoctFrame&, const k::ResoctSource*, std::uint32_t,
+                           std::uint32_t, float, std::uint32_t, float, float, float, float, float,
+                           std::uint32_t&, float&, glm::vec4&, k::ResoctRayStats&);
+
+// The multi-channel loop's copies, as packet_loops().
+std::vector<MultiLoop> multi_loops() {
+  std::vector<MultiLoop> loops{&resoct::cpu::detail::segment_samples_multi_baseline};
+#ifdef RESOCT_PACKETS_AVX2
+  if (resoct::cpu::detail::segment_packets_avx2()) {
+    loops.push_back(&resoct::cpu::detail::segment_samples_multi_avx2);
+  }
+#endif
+  return loops;
+}
+
+// Segments in which 2..6 of up to 8 channels yield values (mapped bricks of both cache slots,
+// constants, NaN constants), mixed in channel order: the packet copies against the march's
+// per-sample pass as kernel::resoct_segment_samples_multi spells it out, bit for bit.
+template <class T>
+int compare_multi_loops(VoxelType type, std::uint32_t seed, int cases) {
+  std::mt19937 rng(seed);
+  Fixture fx = make_fixture<T>(rng, type);
+  resoct::cpu::detail::t_ctx = &fx.ctx;
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int saturated = 0;
+  int ran = 0;
+  for (int c = 0; c < cases; ++c) {
+    k::ResoctFrame f{};
+    f.ref_step = 0.002f + u(rng) * 0.01f;
+    f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
+    f.max_iterations = 40u + std::uint32_t(rng() % 200u);
+    f.step_level_count = kLevels;
+    const std::uint32_t step_level =
+        u(rng) < 0.25f ? k::RESOCT_STEP_LEVEL_NONE : std::uint32_t(rng() % kLevels);
+
+    const std::uint32_t n = 2u + std::uint32_t(rng() % 7u);
+    k::ResoctSource src[k::RESOCT_MAX_SLOTS];
+    std::uint32_t values = 0;
+    const glm::vec3 dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f));
+    for (std::uint32_t ch = 0; ch < n; ++ch) {
+      src[ch] = k::resoct_source_of(k::RESOCT_CH_NONE, 0.0f);
+      if (u(rng) < 0.3f) continue;  // a channel without values in this segment
+      values |= 1u << ch;
+      src[ch] = k::resoct_source_of(k::RESOCT_CH_VALUE, u(rng) * 1.4f - 0.2f);
+      if (u(rng) < 0.05f) src[ch].value = std::numeric_limits<float>::quiet_NaN();
+      src[ch].tf_slot = std::uint32_t(rng() % 2u);
+      if (u(rng) < 0.8f) {
+        src[ch].cache_slot = std::uint32_t(rng() % 2u);
+        const float hi = std::is_same_v<T, float> ? 250.0f : float(std::numeric_limits<T>::max());
+        src[ch].range_lo = u(rng) * 0.2f * hi;
+        src[ch].inv_range_width = 1.0f / (hi * (0.5f + u(rng)));
+        // Channels at different levels: the same ray, other scales and bases.
+        src[ch].ray_base =
+            glm::vec3(u(rng) * 14.0f - 2.0f, u(rng) * 13.0f - 2.0f, u(rng) * 11.0f - 2.0f);
+        src[ch].ray_dir = dir * (20.0f + u(rng) * 200.0f);
+      }
+    }
+    if ((values & (values - 1u)) == 0u) continue;  // fewer than two value channels
+    float dt = 0.001f + u(rng) * 0.01f;
+    float t_grid = u(rng) * 0.5f;
+    if (u(rng) < 0.05f) {
+      t_grid = 3000.0f + u(rng);
+      dt = 1e-4f * (0.5f + 3.0f * u(rng));
+    }
+    const std::uint32_t j0 = std::uint32_t(rng() % 50u);
+    const float t0 = k::resoct_grid_t(t_grid, j0, dt, -1.0f);
+    const float t_exit = t0 + dt * (0.5f + u(rng) * 60.0f);
+    const float seg_next = u(rng) < 0.5f ? t_exit + 1.0f : t0 + dt * (1.0f + u(rng) * 40.0f);
+    const float seg = k::resoct_segment_length(t0, dt, t_exit);
+    const float tm = t0 + 0.5f * seg;
+    if (!(t_exit - t0 > k::RESOCT_SEGMENT_EPS * dt) || !(tm < seg_next)) continue;
+
+    Outcome start{};
+    start.t = t0;
+    start.j = j0;
+    const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
+    start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
+    start.stats.samples = std::uint32_t(rng() % 100u);
+    start.stats.brick_accesses = std::uint32_t(rng() % 100u);
+    start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
+    start.stats.marched = u(rng);
+
+    Outcome scalar = start;
+    scalar.saturated =
+        k::resoct_segment_samples_multi(f, src, values, n, dt, step_level, t_exit, seg_next, seg,
+                                        tm, t_grid, scalar.j, scalar.t, scalar.acc, scalar.stats);
+    for (auto* loop : multi_loops()) {
+      Outcome packets = start;
+      packets.saturated = loop(f, src, values, n, dt, step_level, t_exit, seg_next, seg, tm, t_grid,
+                               packets.j, packets.t, packets.acc, packets.stats);
+      expect_identical(scalar, packets, c);
+    }
+    if (::testing::Test::HasFatalFailure()) break;
+    ++ran;
+    if (scalar.saturated) ++saturated;
+  }
+  resoct::cpu::detail::t_ctx = nullptr;
+  EXPECT_GT(ran, cases / 2);
+  return saturated;
+}
+
 TEST(CpuSegmentPackets, U8BitIdenticalToTheSingleSourceLoop) {
   const int saturated = compare_loops<std::uint8_t>(VoxelType::u8, 11u, 20000);
   EXPECT_GT(saturated, 1000);
@@ -216,6 +320,28 @@ TEST(CpuSegmentPackets, F32BitIdenticalToTheSingleSourceLoop) {
   const int saturated = compare_loops<float>(VoxelType::f32, 13u, 20000);
   EXPECT_GT(saturated, 1000);
   EXPECT_LT(saturated, 19000);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(CpuSegmentPackets, MultiChannelU8BitIdenticalToThePerSamplePass) {
+  const int saturated = compare_multi_loops<std::uint8_t>(VoxelType::u8, 21u, 10000);
+  EXPECT_GT(saturated, 500);
+  EXPECT_LT(saturated, 9500);
+}
+
+TEST(CpuSegmentPackets, MultiChannelU16BitIdenticalToThePerSamplePass) {
+  const int saturated = compare_multi_loops<std::uint16_t>(VoxelType::u16, 22u, 10000);
+  EXPECT_GT(saturated, 500);
+  EXPECT_LT(saturated, 9500);
+}
+
+TEST(CpuSegmentPackets, MultiChannelF32BitIdenticalToThePerSamplePass) {
+  const int saturated = compare_multi_loops<float>(VoxelType::f32, 23u, 10000);
+  EXPECT_GT(saturated, 500);
+  EXPECT_LT(saturated, 9500);
 }
 
 }  // namespace

@@ -93,6 +93,68 @@ RESOCT_LOOP_FN bool resoct_segment_samples(RESOCT_FRAME_IN f, RESOCT_IN(ResoctSo
   return saturated;
 }
 
+#ifdef __cplusplus
+/// The samples of one segment in which several channels yield values (the bits of `values`
+/// among the first n entries of `src`, each RESOCT_CH_VALUE), without effects: per sample the
+/// march's own per-sample pass (traverse.glsl.h), i.e. every such channel sampled and mixed in
+/// channel order (a full step of a ray with a step level from the level's LUT, any other step
+/// corrected per sample), then one composite; the contract is resoct_segment_samples'. C++ only:
+/// the CPU backend replaces it with packets (RESOCT_SEGMENT_SAMPLES_MULTI,
+/// src/backend_cpu/segment_packets_multi.hpp) and tests those against it; GLSL runs the march's
+/// pass, whose arithmetic this repeats operation for operation.
+RESOCT_LOOP_FN bool resoct_segment_samples_multi(RESOCT_FRAME_IN f, const ResoctSource* src,
+                                                 uint values, uint n, float dt, uint step_level,
+                                                 float t_exit, float seg_next, float seg, float tm,
+                                                 float t_grid, RESOCT_INOUT(uint) grid_j,
+                                                 RESOCT_INOUT(float) t, RESOCT_INOUT(vec4) acc,
+                                                 RESOCT_INOUT(ResoctRayStats) stats) {
+  float t_now = t;
+  uint j = grid_j;
+  vec4 a = acc;
+  ResoctRayStats st = stats;
+  bool saturated = false;
+  for (;;) {
+    vec4 weighted;
+    float combined;
+    resoct_mix_begin(weighted, combined);
+    bool from_level = seg == dt && step_level != RESOCT_STEP_LEVEL_NONE;
+    for (uint c = 0u; c < n; ++c) {
+      if (((values >> c) & 1u) == 0u) continue;
+      float value;
+      resoct_source_sample_t(src[c], tm, value, st);
+      if (from_level) {
+        resoct_mix_add_premultiplied(
+            weighted, combined,
+            resoct_step_lut_lookup(src[c].tf_slot, step_level, f.step_level_count, value));
+      } else {
+        vec4 rgba = resoct_tf_lookup(src[c].tf_slot, value);
+        resoct_mix_add(weighted, combined, vec3(rgba.r, rgba.g, rgba.b),
+                       resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step)));
+      }
+    }
+    st.samples = st.samples + 1u;
+    a = resoct_composite(a, resoct_mix_result(weighted, combined));
+    if (resoct_saturated(a, f.ert_opacity)) {
+      saturated = true;
+      break;
+    }
+    st.marched = st.marched + seg;
+    j = j + 1u;
+    t_now = resoct_grid_t(t_grid, j, dt, t_now);
+    if (!(t_exit - t_now > RESOCT_SEGMENT_EPS * dt) || st.iterations >= f.max_iterations) break;
+    seg = resoct_segment_length(t_now, dt, t_exit);
+    tm = t_now + 0.5f * seg;
+    if (!(tm < seg_next)) break;
+    st.iterations = st.iterations + 1u;
+  }
+  t = t_now;
+  grid_j = j;
+  acc = a;
+  stats = st;
+  return saturated;
+}
+#endif
+
 RESOCT_KERNEL_END
 
 // The loop the march calls. A backend may replace it with an implementation of the same contract

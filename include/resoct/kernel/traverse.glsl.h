@@ -475,6 +475,21 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         if (stop) break;
         continue;
       }
+#ifdef RESOCT_SEGMENT_SAMPLES_MULTI
+      // A backend's loop for segments in which several channels yield values, with the
+      // arithmetic of the pass below (the CPU backend's packets; GLSL runs the pass).
+      bool multi = false;
+      RESOCT_IF_FX(RESOCT_EFFECT_ANY | RESOCT_EFFECT_PREINT) {}
+      else {
+        multi = !skip && (seg_values & (seg_values - 1u)) != 0u && tm < seg_next;
+      }
+      if (multi) {
+        stop = RESOCT_SEGMENT_SAMPLES_MULTI(f, src, seg_values, n, dt, step_level, t_exit, seg_next,
+                                            seg, tm, t_grid, grid_j, t, acc, stats);
+        if (stop) break;
+        continue;
+      }
+#endif
 
       bool any_value = false;
       vec4 weighted;
