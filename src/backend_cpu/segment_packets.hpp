@@ -184,6 +184,58 @@ template <int N>
   }
 }
 
+// The next packet of the loop in state `s`: lane 0 is the pending sample, the others follow the
+// scalar loop's control (schedule_lanes); unused lanes repeat lane 0, so that their reads stay
+// inside the bricks.
+[[gnu::always_inline]] inline void next_packet4(const kernel::ResoctFrame& f, float dt,
+                                                float t_exit, float seg_next, float t_grid,
+                                                const PacketLoopState& s, PacketSchedule<4>& sc) {
+  sc.lane_tm[0] = s.tm;
+  sc.lane_seg[0] = s.seg;
+  sc.lane_t[0] = s.t_now;
+  schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
+  for (int l = sc.m; l < 4; ++l) {
+    sc.lane_tm[l] = sc.lane_tm[0];
+    sc.lane_seg[l] = sc.lane_seg[0];
+  }
+}
+
+// A packet's normalized values of one source at the lanes' midpoints `tmv`
+// (resoct_source_sample_t per lane): the constant, or the trilinear samples of its mapped brick.
+[[gnu::always_inline]] inline v4f source_values4(const KernelContext& ctx,
+                                                 const kernel::ResoctSource& src,
+                                                 const std::byte* brick, v4f tmv) {
+  if (brick == nullptr) return splat(src.value);
+  const v4f px = splat(src.ray_base.x) + tmv * splat(src.ray_dir.x);
+  const v4f py = splat(src.ray_base.y) + tmv * splat(src.ray_dir.y);
+  const v4f pz = splat(src.ray_base.z) + tmv * splat(src.ray_dir.z);
+  v4f raw;
+  switch (ctx.type) {
+    case VoxelType::u8: raw = trilinear4<std::uint8_t>(brick, ctx.geometry, px, py, pz); break;
+    case VoxelType::u16: raw = trilinear4<std::uint16_t>(brick, ctx.geometry, px, py, pz); break;
+    default: raw = trilinear4<float>(brick, ctx.geometry, px, py, pz); break;
+  }
+  return (raw - splat(src.range_lo)) * splat(src.inv_range_width);
+}
+
+// resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), LUT index and fraction per lane, and the
+// lanes whose value is NaN.
+struct TfIndex4 {
+  v4i nan, i0;
+  v4f fr;
+};
+[[gnu::always_inline]] inline TfIndex4 tf_index4(v4f value) {
+  TfIndex4 r;
+  r.nan = value != value;
+  v4f x = select(value < splat(0.0f), splat(0.0f), value);
+  x = select(splat(1.0f) < x, splat(1.0f), x) * splat(float(kernel::RESOCT_TF_LUT_SIZE - 1u));
+  r.i0 = __builtin_convertvector(x, v4i);
+  const std::int32_t last = std::int32_t(kernel::RESOCT_TF_LUT_SIZE - 2u);
+  r.i0 = select(splat(last) < r.i0, splat(last), r.i0);
+  r.fr = x - __builtin_convertvector(r.i0, v4f);
+  return r;
+}
+
 // Lane `l`'s premultiplied sample (resoct_mix_result of this one channel) from its normalized
 // value, LUT index i0 and fraction fr: a full step of a ray with a step level from the level's
 // LUT (resoct_step_lut_lookup, 0 where alpha is 0), any other step corrected per sample with the
@@ -257,44 +309,15 @@ inline const glm::vec4* level_lut_of(const KernelContext& ctx, const kernel::Res
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
     PacketSchedule<4> sc;
-    sc.lane_tm[0] = s.tm;
-    sc.lane_seg[0] = s.seg;
-    sc.lane_t[0] = s.t_now;
-    schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
-    // Unused lanes repeat lane 0, so that their loads stay inside the brick.
-    for (int l = sc.m; l < 4; ++l) {
-      sc.lane_tm[l] = sc.lane_tm[0];
-      sc.lane_seg[l] = sc.lane_seg[0];
-    }
+    next_packet4(f, dt, t_exit, seg_next, t_grid, s, sc);
 
     const v4f tmv{sc.lane_tm[0], sc.lane_tm[1], sc.lane_tm[2], sc.lane_tm[3]};
-    v4f value = splat(src.value);
-    if (mapped) {
-      const v4f px = splat(src.ray_base.x) + tmv * splat(src.ray_dir.x);
-      const v4f py = splat(src.ray_base.y) + tmv * splat(src.ray_dir.y);
-      const v4f pz = splat(src.ray_base.z) + tmv * splat(src.ray_dir.z);
-      v4f raw;
-      switch (ctx.type) {
-        case VoxelType::u8: raw = trilinear4<std::uint8_t>(brick, ctx.geometry, px, py, pz); break;
-        case VoxelType::u16:
-          raw = trilinear4<std::uint16_t>(brick, ctx.geometry, px, py, pz);
-          break;
-        default: raw = trilinear4<float>(brick, ctx.geometry, px, py, pz); break;
-      }
-      value = (raw - splat(src.range_lo)) * splat(src.inv_range_width);
-    }
-    // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
-    const v4i nan = value != value;
-    v4f x = select(value < splat(0.0f), splat(0.0f), value);
-    x = select(splat(1.0f) < x, splat(1.0f), x) * splat(float(RESOCT_TF_LUT_SIZE - 1u));
-    v4i i0 = __builtin_convertvector(x, v4i);
-    const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
-    i0 = select(splat(last) < i0, splat(last), i0);
-    const v4f fr = x - __builtin_convertvector(i0, v4f);
+    const v4f value = source_values4(ctx, src, brick, tmv);
+    const TfIndex4 ix = tf_index4(value);
     v4f pm[4];
     for (int l = 0; l < sc.m; ++l) {
-      pm[l] =
-          lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
+      pm[l] = lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], ix.nan[l] != 0, ix.i0[l],
+                          ix.fr[l]);
     }
     if (composite_lanes(f, mapped ? 1u : 0u, pm, sc, s)) break;
   }

@@ -119,6 +119,39 @@ template <class T>
   return c0 + fz * (c1 - c0);
 }
 
+// source_values4 (segment_packets.hpp) for eight lanes.
+[[gnu::target("avx2"), gnu::always_inline]] inline v8f source_values8(
+    const KernelContext& ctx, const kernel::ResoctSource& src, const std::byte* brick, v8f tmv) {
+  if (brick == nullptr) return splat8(src.value);
+  const v8f px = splat8(src.ray_base.x) + tmv * splat8(src.ray_dir.x);
+  const v8f py = splat8(src.ray_base.y) + tmv * splat8(src.ray_dir.y);
+  const v8f pz = splat8(src.ray_base.z) + tmv * splat8(src.ray_dir.z);
+  v8f raw;
+  switch (ctx.type) {
+    case VoxelType::u8: raw = trilinear8<std::uint8_t>(brick, ctx.geometry, px, py, pz); break;
+    case VoxelType::u16: raw = trilinear8<std::uint16_t>(brick, ctx.geometry, px, py, pz); break;
+    default: raw = trilinear8<float>(brick, ctx.geometry, px, py, pz); break;
+  }
+  return (raw - splat8(src.range_lo)) * splat8(src.inv_range_width);
+}
+
+// tf_index4 (segment_packets.hpp) for eight lanes.
+struct TfIndex8 {
+  v8i nan, i0;
+  v8f fr;
+};
+[[gnu::target("avx2"), gnu::always_inline]] inline TfIndex8 tf_index8(v8f value) {
+  TfIndex8 r;
+  r.nan = value != value;
+  v8f x = select8(value < splat8(0.0f), splat8(0.0f), value);
+  x = select8(splat8(1.0f) < x, splat8(1.0f), x) * splat8(float(kernel::RESOCT_TF_LUT_SIZE - 1u));
+  r.i0 = __builtin_convertvector(x, v8i);
+  const std::int32_t last = std::int32_t(kernel::RESOCT_TF_LUT_SIZE - 2u);
+  r.i0 = select8(splat8(last) < r.i0, splat8(last), r.i0);
+  r.fr = x - __builtin_convertvector(r.i0, v8f);
+  return r;
+}
+
 // The schedule of an eight-lane packet (lanes from 1 on; lane 0 is set): the scalar loop's
 // control, computed for all lanes at once where the grid's steps strictly increase.
 [[gnu::target("avx2"), gnu::always_inline]] inline void schedule8(const kernel::ResoctFrame& f,
@@ -162,6 +195,22 @@ template <class T>
   }
 }
 
+// next_packet4 (segment_packets.hpp) for eight lanes, scheduled by schedule8.
+[[gnu::target("avx2"), gnu::always_inline]] inline void next_packet8(const kernel::ResoctFrame& f,
+                                                                     float dt, float t_exit,
+                                                                     float seg_next, float t_grid,
+                                                                     const PacketLoopState& s,
+                                                                     PacketSchedule<8>& sc) {
+  sc.lane_tm[0] = s.tm;
+  sc.lane_seg[0] = s.seg;
+  sc.lane_t[0] = s.t_now;
+  schedule8(f, dt, t_exit, seg_next, t_grid, s, sc);
+  for (int l = sc.m; l < 8; ++l) {
+    sc.lane_tm[l] = sc.lane_tm[0];
+    sc.lane_seg[l] = sc.lane_seg[0];
+  }
+}
+
 // The loop in packets of eight, with kernel::resoct_segment_samples' contract.
 [[gnu::noinline, gnu::target("avx2")]] inline bool segment_samples_packets_avx2(
     const kernel::ResoctFrame& f, const kernel::ResoctSource& src, float dt,
@@ -181,45 +230,16 @@ template <class T>
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
     PacketSchedule<8> sc;
-    sc.lane_tm[0] = s.tm;
-    sc.lane_seg[0] = s.seg;
-    sc.lane_t[0] = s.t_now;
-    schedule8(f, dt, t_exit, seg_next, t_grid, s, sc);
-    // Unused lanes repeat lane 0, so that their reads stay inside the brick.
-    for (int l = sc.m; l < 8; ++l) {
-      sc.lane_tm[l] = sc.lane_tm[0];
-      sc.lane_seg[l] = sc.lane_seg[0];
-    }
+    next_packet8(f, dt, t_exit, seg_next, t_grid, s, sc);
 
     v8f tmv;
     for (int l = 0; l < 8; ++l) tmv[l] = sc.lane_tm[l];
-    v8f value = splat8(src.value);
-    if (mapped) {
-      const v8f px = splat8(src.ray_base.x) + tmv * splat8(src.ray_dir.x);
-      const v8f py = splat8(src.ray_base.y) + tmv * splat8(src.ray_dir.y);
-      const v8f pz = splat8(src.ray_base.z) + tmv * splat8(src.ray_dir.z);
-      v8f raw;
-      switch (ctx.type) {
-        case VoxelType::u8: raw = trilinear8<std::uint8_t>(brick, ctx.geometry, px, py, pz); break;
-        case VoxelType::u16:
-          raw = trilinear8<std::uint16_t>(brick, ctx.geometry, px, py, pz);
-          break;
-        default: raw = trilinear8<float>(brick, ctx.geometry, px, py, pz); break;
-      }
-      value = (raw - splat8(src.range_lo)) * splat8(src.inv_range_width);
-    }
-    // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
-    const v8i nan = value != value;
-    v8f x = select8(value < splat8(0.0f), splat8(0.0f), value);
-    x = select8(splat8(1.0f) < x, splat8(1.0f), x) * splat8(float(RESOCT_TF_LUT_SIZE - 1u));
-    v8i i0 = __builtin_convertvector(x, v8i);
-    const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
-    i0 = select8(splat8(last) < i0, splat8(last), i0);
-    const v8f fr = x - __builtin_convertvector(i0, v8f);
+    const v8f value = source_values8(ctx, src, brick, tmv);
+    const TfIndex8 ix = tf_index8(value);
     v4f pm[8];
     for (int l = 0; l < sc.m; ++l) {
-      pm[l] =
-          lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l]);
+      pm[l] = lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], ix.nan[l] != 0, ix.i0[l],
+                          ix.fr[l]);
     }
     if (composite_lanes(f, mapped ? 1u : 0u, pm, sc, s)) break;
   }

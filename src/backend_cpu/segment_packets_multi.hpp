@@ -94,15 +94,7 @@ inline std::uint32_t multi_channels(const KernelContext& ctx, const kernel::Reso
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
     PacketSchedule<4> sc;
-    sc.lane_tm[0] = s.tm;
-    sc.lane_seg[0] = s.seg;
-    sc.lane_t[0] = s.t_now;
-    schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
-    // Unused lanes repeat lane 0, so that their loads stay inside the bricks.
-    for (int l = sc.m; l < 4; ++l) {
-      sc.lane_tm[l] = sc.lane_tm[0];
-      sc.lane_seg[l] = sc.lane_seg[0];
-    }
+    next_packet4(f, dt, t_exit, seg_next, t_grid, s, sc);
     const v4f tmv{sc.lane_tm[0], sc.lane_tm[1], sc.lane_tm[2], sc.lane_tm[3]};
     v4f weighted[4];
     float combined[4];
@@ -111,35 +103,11 @@ inline std::uint32_t multi_channels(const KernelContext& ctx, const kernel::Reso
       combined[l] = 0.0f;
     }
     for (std::uint32_t c = 0; c < k; ++c) {
-      const ResoctSource& cs = *ch[c].src;
-      v4f value = splat(cs.value);
-      if (ch[c].brick != nullptr) {
-        const v4f px = splat(cs.ray_base.x) + tmv * splat(cs.ray_dir.x);
-        const v4f py = splat(cs.ray_base.y) + tmv * splat(cs.ray_dir.y);
-        const v4f pz = splat(cs.ray_base.z) + tmv * splat(cs.ray_dir.z);
-        v4f raw;
-        switch (ctx.type) {
-          case VoxelType::u8:
-            raw = trilinear4<std::uint8_t>(ch[c].brick, ctx.geometry, px, py, pz);
-            break;
-          case VoxelType::u16:
-            raw = trilinear4<std::uint16_t>(ch[c].brick, ctx.geometry, px, py, pz);
-            break;
-          default: raw = trilinear4<float>(ch[c].brick, ctx.geometry, px, py, pz); break;
-        }
-        value = (raw - splat(cs.range_lo)) * splat(cs.inv_range_width);
-      }
-      // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
-      const v4i nan = value != value;
-      v4f x = select(value < splat(0.0f), splat(0.0f), value);
-      x = select(splat(1.0f) < x, splat(1.0f), x) * splat(float(RESOCT_TF_LUT_SIZE - 1u));
-      v4i i0 = __builtin_convertvector(x, v4i);
-      const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
-      i0 = select(splat(last) < i0, splat(last), i0);
-      const v4f fr = x - __builtin_convertvector(i0, v4f);
+      const v4f value = source_values4(ctx, *ch[c].src, ch[c].brick, tmv);
+      const TfIndex4 ix = tf_index4(value);
       for (int l = 0; l < sc.m; ++l) {
-        mix_lane(f, ch[c], dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l], weighted[l],
-                 combined[l]);
+        mix_lane(f, ch[c], dt, sc.lane_seg[l], value[l], ix.nan[l] != 0, ix.i0[l], ix.fr[l],
+                 weighted[l], combined[l]);
       }
     }
     v4f pm[4];
@@ -170,15 +138,7 @@ inline std::uint32_t multi_channels(const KernelContext& ctx, const kernel::Reso
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
     PacketSchedule<8> sc;
-    sc.lane_tm[0] = s.tm;
-    sc.lane_seg[0] = s.seg;
-    sc.lane_t[0] = s.t_now;
-    schedule8(f, dt, t_exit, seg_next, t_grid, s, sc);
-    // Unused lanes repeat lane 0, so that their reads stay inside the bricks.
-    for (int l = sc.m; l < 8; ++l) {
-      sc.lane_tm[l] = sc.lane_tm[0];
-      sc.lane_seg[l] = sc.lane_seg[0];
-    }
+    next_packet8(f, dt, t_exit, seg_next, t_grid, s, sc);
     v8f tmv;
     for (int l = 0; l < 8; ++l) tmv[l] = sc.lane_tm[l];
     v4f weighted[8];
@@ -188,35 +148,11 @@ inline std::uint32_t multi_channels(const KernelContext& ctx, const kernel::Reso
       combined[l] = 0.0f;
     }
     for (std::uint32_t c = 0; c < k; ++c) {
-      const ResoctSource& cs = *ch[c].src;
-      v8f value = splat8(cs.value);
-      if (ch[c].brick != nullptr) {
-        const v8f px = splat8(cs.ray_base.x) + tmv * splat8(cs.ray_dir.x);
-        const v8f py = splat8(cs.ray_base.y) + tmv * splat8(cs.ray_dir.y);
-        const v8f pz = splat8(cs.ray_base.z) + tmv * splat8(cs.ray_dir.z);
-        v8f raw;
-        switch (ctx.type) {
-          case VoxelType::u8:
-            raw = trilinear8<std::uint8_t>(ch[c].brick, ctx.geometry, px, py, pz);
-            break;
-          case VoxelType::u16:
-            raw = trilinear8<std::uint16_t>(ch[c].brick, ctx.geometry, px, py, pz);
-            break;
-          default: raw = trilinear8<float>(ch[c].brick, ctx.geometry, px, py, pz); break;
-        }
-        value = (raw - splat8(cs.range_lo)) * splat8(cs.inv_range_width);
-      }
-      // resoct_tf_lookup's clamp (GLM's min(max(v, 0), 1)), index and fraction.
-      const v8i nan = value != value;
-      v8f x = select8(value < splat8(0.0f), splat8(0.0f), value);
-      x = select8(splat8(1.0f) < x, splat8(1.0f), x) * splat8(float(RESOCT_TF_LUT_SIZE - 1u));
-      v8i i0 = __builtin_convertvector(x, v8i);
-      const std::int32_t last = std::int32_t(RESOCT_TF_LUT_SIZE - 2u);
-      i0 = select8(splat8(last) < i0, splat8(last), i0);
-      const v8f fr = x - __builtin_convertvector(i0, v8f);
+      const v8f value = source_values8(ctx, *ch[c].src, ch[c].brick, tmv);
+      const TfIndex8 ix = tf_index8(value);
       for (int l = 0; l < sc.m; ++l) {
-        mix_lane(f, ch[c], dt, sc.lane_seg[l], value[l], nan[l] != 0, i0[l], fr[l], weighted[l],
-                 combined[l]);
+        mix_lane(f, ch[c], dt, sc.lane_seg[l], value[l], ix.nan[l] != 0, ix.i0[l], ix.fr[l],
+                 weighted[l], combined[l]);
       }
     }
     v4f pm[8];

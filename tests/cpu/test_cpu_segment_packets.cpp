@@ -123,6 +123,60 @@ void expect_identical(const Outcome& a, const Outcome& b, int c) {
       << "case " << c;
 }
 
+// A random frame for one case: reference step, termination (sometimes never), iteration cap and
+// the ray's step level (sometimes none).
+struct CaseFrame {
+  k::ResoctFrame f{};
+  std::uint32_t step_level = 0;
+};
+CaseFrame random_frame(std::mt19937& rng, std::uniform_real_distribution<float>& u) {
+  CaseFrame c;
+  c.f.ref_step = 0.002f + u(rng) * 0.01f;
+  c.f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
+  c.f.max_iterations = 40u + std::uint32_t(rng() % 200u);
+  c.f.step_level_count = kLevels;
+  c.step_level = u(rng) < 0.25f ? k::RESOCT_STEP_LEVEL_NONE : std::uint32_t(rng() % kLevels);
+  return c;
+}
+
+// A random segment of a step grid and the loop state at its first sample; `valid` is false when
+// no sample of it lies before its end and its next decision.
+struct CaseSegment {
+  float dt = 0, t_grid = 0, t_exit = 0, seg_next = 0, seg = 0, tm = 0;
+  Outcome start{};
+  bool valid = false;
+};
+CaseSegment random_segment(std::mt19937& rng, std::uniform_real_distribution<float>& u,
+                           const k::ResoctFrame& f) {
+  CaseSegment c;
+  c.dt = 0.001f + u(rng) * 0.01f;
+  // The segment starts at step j0 of a grid (kernel::resoct_grid_t).
+  c.t_grid = u(rng) * 0.5f;
+  // Some grids far along the ray with steps near or below an ulp of t, where resoct_grid_t's
+  // guard decides and the eight-lane copy schedules lane by lane.
+  if (u(rng) < 0.05f) {
+    c.t_grid = 3000.0f + u(rng);
+    c.dt = 1e-4f * (0.5f + 3.0f * u(rng));
+  }
+  const std::uint32_t j0 = std::uint32_t(rng() % 50u);
+  const float t0 = k::resoct_grid_t(c.t_grid, j0, c.dt, -1.0f);
+  c.t_exit = t0 + c.dt * (0.5f + u(rng) * 60.0f);
+  c.seg_next = u(rng) < 0.5f ? c.t_exit + 1.0f : t0 + c.dt * (1.0f + u(rng) * 40.0f);
+  c.seg = k::resoct_segment_length(t0, c.dt, c.t_exit);
+  c.tm = t0 + 0.5f * c.seg;
+  if (!(c.t_exit - t0 > k::RESOCT_SEGMENT_EPS * c.dt) || !(c.tm < c.seg_next)) return c;
+  c.start.t = t0;
+  c.start.j = j0;
+  const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
+  c.start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
+  c.start.stats.samples = std::uint32_t(rng() % 100u);
+  c.start.stats.brick_accesses = std::uint32_t(rng() % 100u);
+  c.start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
+  c.start.stats.marched = u(rng);
+  c.valid = true;
+  return c;
+}
+
 // Runs `cases` random segments through both loops; returns how many ended by saturation, so
 // that the caller can check the cases cover both ends.
 template <class T>
@@ -134,13 +188,9 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
   int saturated = 0;
   int on_grid = 0;
   for (int c = 0; c < cases; ++c) {
-    k::ResoctFrame f{};
-    f.ref_step = 0.002f + u(rng) * 0.01f;
-    f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
-    f.max_iterations = 40u + std::uint32_t(rng() % 200u);
-    f.step_level_count = kLevels;
-    const std::uint32_t step_level =
-        u(rng) < 0.25f ? k::RESOCT_STEP_LEVEL_NONE : std::uint32_t(rng() % kLevels);
+    const CaseFrame cf = random_frame(rng, u);
+    const k::ResoctFrame& f = cf.f;
+    const std::uint32_t step_level = cf.step_level;
 
     k::ResoctSource src = k::resoct_source_of(k::RESOCT_CH_VALUE, u(rng) * 1.4f - 0.2f);
     if (u(rng) < 0.05f) src.value = std::numeric_limits<float>::quiet_NaN();
@@ -155,32 +205,11 @@ int compare_loops(VoxelType type, std::uint32_t seed, int cases) {
       src.ray_dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f)) *
                     (20.0f + u(rng) * 200.0f);
     }
-    float dt = 0.001f + u(rng) * 0.01f;
-    // The segment starts at step j0 of a grid (kernel::resoct_grid_t).
-    float t_grid = u(rng) * 0.5f;
-    // Some grids far along the ray with steps near or below an ulp of t, where resoct_grid_t's
-    // guard decides and the eight-lane copy schedules lane by lane.
-    if (u(rng) < 0.05f) {
-      t_grid = 3000.0f + u(rng);
-      dt = 1e-4f * (0.5f + 3.0f * u(rng));
-    }
-    const std::uint32_t j0 = std::uint32_t(rng() % 50u);
-    const float t0 = k::resoct_grid_t(t_grid, j0, dt, -1.0f);
-    const float t_exit = t0 + dt * (0.5f + u(rng) * 60.0f);
-    const float seg_next = u(rng) < 0.5f ? t_exit + 1.0f : t0 + dt * (1.0f + u(rng) * 40.0f);
-    const float seg = k::resoct_segment_length(t0, dt, t_exit);
-    const float tm = t0 + 0.5f * seg;
-    if (!(t_exit - t0 > k::RESOCT_SEGMENT_EPS * dt) || !(tm < seg_next)) continue;
-
-    Outcome start{};
-    start.t = t0;
-    start.j = j0;
-    const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
-    start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
-    start.stats.samples = std::uint32_t(rng() % 100u);
-    start.stats.brick_accesses = std::uint32_t(rng() % 100u);
-    start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
-    start.stats.marched = u(rng);
+    const CaseSegment cs = random_segment(rng, u, f);
+    if (!cs.valid) continue;
+    const float dt = cs.dt, t_grid = cs.t_grid, t_exit = cs.t_exit, seg_next = cs.seg_next;
+    const float seg = cs.seg, tm = cs.tm;
+    const Outcome& start = cs.start;
 
     Outcome scalar = start;
     scalar.saturated =
@@ -230,13 +259,9 @@ int compare_multi_loops(VoxelType type, std::uint32_t seed, int cases) {
   int saturated = 0;
   int ran = 0;
   for (int c = 0; c < cases; ++c) {
-    k::ResoctFrame f{};
-    f.ref_step = 0.002f + u(rng) * 0.01f;
-    f.ert_opacity = u(rng) < 0.2f ? 2.0f : 0.9f + u(rng) * 0.1f;
-    f.max_iterations = 40u + std::uint32_t(rng() % 200u);
-    f.step_level_count = kLevels;
-    const std::uint32_t step_level =
-        u(rng) < 0.25f ? k::RESOCT_STEP_LEVEL_NONE : std::uint32_t(rng() % kLevels);
+    const CaseFrame cf = random_frame(rng, u);
+    const k::ResoctFrame& f = cf.f;
+    const std::uint32_t step_level = cf.step_level;
 
     const std::uint32_t n = 2u + std::uint32_t(rng() % 7u);
     k::ResoctSource src[k::RESOCT_MAX_SLOTS];
@@ -261,29 +286,11 @@ int compare_multi_loops(VoxelType type, std::uint32_t seed, int cases) {
       }
     }
     if ((values & (values - 1u)) == 0u) continue;  // fewer than two value channels
-    float dt = 0.001f + u(rng) * 0.01f;
-    float t_grid = u(rng) * 0.5f;
-    if (u(rng) < 0.05f) {
-      t_grid = 3000.0f + u(rng);
-      dt = 1e-4f * (0.5f + 3.0f * u(rng));
-    }
-    const std::uint32_t j0 = std::uint32_t(rng() % 50u);
-    const float t0 = k::resoct_grid_t(t_grid, j0, dt, -1.0f);
-    const float t_exit = t0 + dt * (0.5f + u(rng) * 60.0f);
-    const float seg_next = u(rng) < 0.5f ? t_exit + 1.0f : t0 + dt * (1.0f + u(rng) * 40.0f);
-    const float seg = k::resoct_segment_length(t0, dt, t_exit);
-    const float tm = t0 + 0.5f * seg;
-    if (!(t_exit - t0 > k::RESOCT_SEGMENT_EPS * dt) || !(tm < seg_next)) continue;
-
-    Outcome start{};
-    start.t = t0;
-    start.j = j0;
-    const float a0 = u(rng) < 0.5f ? 0.0f : u(rng) * 0.85f;
-    start.acc = glm::vec4(u(rng) * a0, u(rng) * a0, u(rng) * a0, a0);
-    start.stats.samples = std::uint32_t(rng() % 100u);
-    start.stats.brick_accesses = std::uint32_t(rng() % 100u);
-    start.stats.iterations = f.max_iterations - 1u - std::uint32_t(rng() % 40u);
-    start.stats.marched = u(rng);
+    const CaseSegment cs = random_segment(rng, u, f);
+    if (!cs.valid) continue;
+    const float dt = cs.dt, t_grid = cs.t_grid, t_exit = cs.t_exit, seg_next = cs.seg_next;
+    const float seg = cs.seg, tm = cs.tm;
+    const Outcome& start = cs.start;
 
     Outcome scalar = start;
     scalar.saturated =
