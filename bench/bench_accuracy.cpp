@@ -18,6 +18,11 @@
 //           the step length); the reference is always corrected.
 //         4 early termination opacity {0.99, 0.995, 0.999} × step scale {0.25 .. 4} ×
 //           pre-integration {off, on} at LOD 0.5 px, v = 6i + 2e + p (ERT 1.0 rows: grid)
+//         5 error-bounded LOD (Scene::lod_error_color, docs/rendering.md): step scale
+//           {0.25 .. 4} × LOD {0.5, 4} px (which then sets only the step, through the LOD
+//           floor) × colour error {0.0025, 0.005, 0.01, 0.02, 0.04, 0.08}, no early
+//           termination, pre-integration off, v = 12i + 6j + e: the level comes from the bricks'
+//           measured errors instead of the footprint. Counter lod_color.
 // Every other sweep: pre-integration off, the scene's ERT 0.99. The finest setting, the base of
 // the speed-ups report.py prints, is the grid row step 0.25, LOD 0.5 px, ERT 1.0, pre-integration
 // off: the most accurate point-sampling configuration, like the reference without termination.
@@ -33,6 +38,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -49,18 +55,20 @@ constexpr double kSteps[] = {0.25, 0.5, 1.0, 2.0, 4.0};
 constexpr double kLods[] = {0.5, 1.0, 2.0, 4.0, 8.0};
 const glm::uvec3 kLeaves[] = {glm::uvec3(32), glm::uvec3(16), glm::uvec3(8)};
 constexpr double kErts[] = {0.99, 0.995, 0.999};
+constexpr double kColors[] = {0.0025, 0.005, 0.01, 0.02, 0.04, 0.08};
 
-Rig& rig_for(int dataset, int leaf) {
-  static std::pair<int, int> key{-1, -1};
+// One rig at a time; `errors`: coarse bricks carry their measured errors (sweep 5).
+Rig& rig_for(int dataset, int leaf, bool errors = false) {
+  static std::tuple<int, int, bool> key{-1, -1, false};
   static std::unique_ptr<Rig> rig;
-  if (!rig || key != std::pair<int, int>{dataset, leaf}) {
+  if (!rig || key != std::tuple<int, int, bool>{dataset, leaf, errors}) {
     rig.reset();
     std::vector<std::uint32_t> channels;
     for (std::uint32_t c = 0; c < effect_dataset_visible_channels(dataset); ++c)
       channels.push_back(c);
     rig = std::make_unique<Rig>(effect_dataset_spec(dataset), channels, glm::uvec3(32),
-                                kLeaves[leaf]);
-    key = {dataset, leaf};
+                                kLeaves[leaf], 0, 1, errors);
+    key = {dataset, leaf, errors};
   }
   return *rig;
 }
@@ -110,10 +118,10 @@ void BM_Accuracy(benchmark::State& state) {
   const int sweep = int(state.range(1));
   const int value = int(state.range(2));
   const int leaf = sweep == 2 ? value : 1;
-  Scene scene = bench_scene(rig_for(dataset, 1), effect_dataset_visible_channels(dataset),
-                            effect_dataset_image_size());
+  Scene scene = bench_scene(rig_for(dataset, 1, sweep == 5),
+                            effect_dataset_visible_channels(dataset), effect_dataset_image_size());
   const Image& reference = reference_for(dataset, scene);
-  Rig& rig = rig_for(dataset, leaf);
+  Rig& rig = rig_for(dataset, leaf, sweep == 5);
   bool uncorrected = false;
   std::string label = kNames[dataset];
   switch (sweep) {
@@ -136,6 +144,13 @@ void BM_Accuracy(benchmark::State& state) {
       uncorrected = value % 2 == 1;
       for (auto& c : scene.channels) c.coarsest_level = 0;
       label += uncorrected ? "/opacity-correction off" : "/opacity-correction on";
+      break;
+    case 5:
+      scene.step_scale = kSteps[value / 12];
+      scene.lod_error_px = (value / 6) % 2 == 0 ? 0.5 : 4.0;
+      scene.lod_error_color = kColors[value % 6];
+      scene.ert_opacity = 1.0;
+      label += "/error-bounded " + std::to_string(kColors[value % 6]).substr(0, 6);
       break;
     default:
       scene.step_scale = kSteps[value / 6];
@@ -161,14 +176,15 @@ void BM_Accuracy(benchmark::State& state) {
   state.counters["lod_px"] = scene.lod_error_px;
   state.counters["preint"] = scene.preintegration ? 1.0 : 0.0;
   state.counters["ert"] = scene.ert_opacity;
+  state.counters["lod_color"] = scene.lod_error_color;
   state.SetLabel(label);
 }
 
 BENCHMARK(BM_Accuracy)
     ->Apply([](benchmark::internal::Benchmark* b) {
-      const int counts[] = {50, 4, 3, 6, 30};
+      const int counts[] = {50, 4, 3, 6, 30, 60};
       for (int dataset = 0; dataset < 3; ++dataset) {
-        for (int sweep = 0; sweep < 5; ++sweep) {
+        for (int sweep = 0; sweep < 6; ++sweep) {
           for (int v = 0; v < counts[sweep]; ++v) b->Args({dataset, sweep, v});
         }
       }

@@ -227,6 +227,58 @@ def accuracy(ctx, rows, out, plots):
     return verdicts
 
 
+def error_bounded(ctx, rows, out):
+    """bench_accuracy sweep 5 (error-bounded LOD) against the footprint rows of sweep 0 (point
+    sampled, no early termination): the lowest footprint RMSE at no more CPU time, and at no
+    more working set, beside each error-bounded row."""
+    def ms(b):
+        return b.get("cpu_ms_frame", b["ms_frame"])
+
+    by_set = {}
+    for args, b in rows:
+        if args.get("sweep") == 0 and not b.get("preint", 0):
+            by_set.setdefault(args["dataset"], ([], []))[0].append(b)
+        elif args.get("sweep") == 5:
+            by_set.setdefault(args["dataset"], ([], []))[1].append(b)
+    if not any(eb for _, eb in by_set.values()):
+        return {}
+    out.append("### Error-bounded LOD against footprint LOD (`bench_accuracy` sweep 5)\n")
+    out.append(context_line(ctx) + "\n")
+    out.append("Each error-bounded row (colour error τ; its LOD px sets only the step; ERT 1.0) beside the "
+               "lowest RMSE a footprint row of sweep 0 (point sampled, ERT 1.0) reaches in no more "
+               "CPU ms, and in no more working set. Ratio < 1: error-bounded LOD is more exact.\n")
+    best = {}
+    for d, (fp, eb) in sorted(by_set.items()):
+        if not eb or not fp:
+            continue
+        name = ACC_NAMES[d]
+        out.append(f"#### {name}\n")
+        out.append("| τ | step | LOD px | CPU ms | working set MiB | RMSE | footprint RMSE at ≤ "
+                   "CPU ms | ratio | footprint RMSE at ≤ MiB | ratio |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|")
+        for b in sorted(eb, key=lambda b: (b["step_scale"], b["lod_px"], b["lod_color"])):
+            t = [f for f in fp if ms(f) <= ms(b)]
+            m = [f for f in fp if f["working_set_MiB"] <= b["working_set_MiB"]]
+            rt = min((f["rmse"] for f in t), default=None)
+            rm = min((f["rmse"] for f in m), default=None)
+            qt = b["rmse"] / rt if rt else None
+            qm = b["rmse"] / rm if rm else None
+            if qt is not None:
+                best[name] = min(best.get(name, qt), qt)
+            out.append(f"| {b['lod_color']:g} | {fmt(b['step_scale'])} | {fmt(b['lod_px'])} | "
+                       f"{fmt(ms(b))} | "
+                       f"{fmt(b['working_set_MiB'])} | {b['rmse']:.5f} | "
+                       f"{'–' if rt is None else f'{rt:.5f}'} | {fmt(qt)} | "
+                       f"{'–' if rm is None else f'{rm:.5f}'} | {fmt(qm)} |")
+        out.append("")
+    met = [n for n, q in best.items() if q <= 0.7]
+    out.append("Best ratio at equal time per dataset: " +
+               ", ".join(f"{n} {fmt(q)}" for n, q in best.items()) +
+               f". Issue 17's bar (≥ 30 % lower RMSE at equal time on two datasets): "
+               f"{'met' if len(met) >= 2 else 'missed'}.\n")
+    return best
+
+
 OOC_NAMES = ["tubes (4 copies)", "turbulence"]
 
 
@@ -452,6 +504,7 @@ def main():
     t = load(os.path.join(RESULTS, "accuracy.json"))
     if t:
         verdicts = accuracy(*t, out, plots)
+        error_bounded(*t, out)
     t = load(os.path.join(RESULTS, "out_of_core.json"))
     if t:
         out_of_core(*t, out, plots)

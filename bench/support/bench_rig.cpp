@@ -120,7 +120,7 @@ const char* to_string(Preset p) {
 }
 
 Rig::Rig(const std::string& spec, std::vector<std::uint32_t> channels, glm::uvec3 brick_size,
-         glm::uvec3 leaf_size, std::uint32_t duplicates, int threads) {
+         glm::uvec3 leaf_size, std::uint32_t duplicates, int threads, bool brick_errors) {
   BrickLayout layout;
   layout.brick_size = brick_size;
   procedural = std::make_shared<ProceduralSource>(spec, layout);
@@ -131,6 +131,7 @@ Rig::Rig(const std::string& spec, std::vector<std::uint32_t> channels, glm::uvec
   }
   test::ResidentOptions options;
   options.leaf_size = leaf_size;
+  options.brick_errors = brick_errors;
   resident = std::make_unique<test::ResidentScene>(*source, std::move(channels), options);
   backend = make_backend(threads);
   resident->upload(*backend);

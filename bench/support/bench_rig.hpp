@@ -53,10 +53,12 @@ std::unique_ptr<Backend> make_backend(int threads);
 /// test (the CPU backend on one thread by default, so that ms/frame is the traversal's cost, not
 /// the machine's parallelism). With `duplicates` > 0 the source shows channel 0 of `spec` as
 /// that many identical channels (DuplicateChannelSource: the paper's multi-channel protocol for
-/// single-channel data) and bench_scene gives each copy its own value window.
+/// single-channel data) and bench_scene gives each copy its own value window. With
+/// `brick_errors` the coarse bricks carry their measured errors (error-bounded LOD).
 struct Rig {
   Rig(const std::string& spec, std::vector<std::uint32_t> channels, glm::uvec3 brick_size,
-      glm::uvec3 leaf_size, std::uint32_t duplicates = 0, int threads = 1);
+      glm::uvec3 leaf_size, std::uint32_t duplicates = 0, int threads = 1,
+      bool brick_errors = false);
   std::shared_ptr<ProceduralSource> procedural;  ///< the generated data
   std::shared_ptr<const BrickSource> source;     ///< what is rendered (procedural or duplicated)
   std::unique_ptr<test::ResidentScene> resident;

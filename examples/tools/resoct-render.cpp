@@ -63,6 +63,7 @@ struct Args {
   std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
   std::string strategy = "greedy";
   std::uint32_t leaf = 16;
+  std::optional<double> lod_error_color;  // overrides the scene's (error-bounded LOD)
   std::uint32_t retry_failed_ms = 0;
   std::optional<std::uint32_t> timepoint;  // overrides the scene's
   std::string play;                        // "FIRST:LAST": one image per timepoint
@@ -283,6 +284,9 @@ int run(const Args& a) {
   }
   if (a.frames == 0 && !a.converge)
     throw invalid_parameter("frames", "give --frames N or --converge");
+  if (a.lod_error_color && !(*a.lod_error_color >= 0.0 && *a.lod_error_color <= 1.0)) {
+    throw invalid_parameter("lod-error-color", "must be in [0, 1]");
+  }
   if (!(a.reference_step > 0.0 && a.reference_step <= 1.0)) {
     throw invalid_parameter("reference-step", "must be in (0, 1] voxel");
   }
@@ -308,6 +312,9 @@ int run(const Args& a) {
   // A scene file is read before the volume is opened, so that a bad one fails at once.
   std::optional<Scene> from_file;
   if (!a.scene.empty()) from_file = load_scene(a.scene);
+  // Error-bounded LOD needs the loader to measure every coarse brick's error.
+  o.brick_errors = (a.lod_error_color && *a.lod_error_color > 0.0) ||
+                   (from_file && from_file->lod_error_color > 0.0);
   Renderer renderer(std::shared_ptr<const BrickSource>(open_source(a.volume, {}, a.source)), o);
   // Without --scene, the volume's overview: the whole box in view, up to four channels in
   // distinct colours, each a ramp over its value range or, where the source's metadata has
@@ -317,6 +324,7 @@ int run(const Args& a) {
                                            overview_hints(renderer.source()));
   if (a.width != 0) scene.viewport.width = a.width;
   if (a.height != 0) scene.viewport.height = a.height;
+  if (a.lod_error_color) scene.lod_error_color = *a.lod_error_color;
   // Checked before rendering, naming the option rather than the scene field.
   const std::uint32_t timepoints = renderer.timepoints();
   const auto check_timepoint = [&](const char* option, std::uint32_t t) {
@@ -505,6 +513,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
       ->capture_default_str();
+  app.add_option("--lod-error-color", a.lod_error_color,
+                 "error-bounded LOD: sample the coarsest level whose measured error moves a "
+                 "sample's RGBA by at most this (0..1; overrides the scene's; 0 = off; "
+                 "docs/rendering.md)");
   auto* timepoint = app.add_option("--timepoint", a.timepoint,
                                    "timepoint of a time series (overrides the scene's)");
   app.add_option("--play", a.play,

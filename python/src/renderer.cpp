@@ -46,12 +46,15 @@ std::uint64_t mebibytes(std::uint64_t mb, const char* parameter) {
   return mb << 20;
 }
 
-std::unique_ptr<Renderer> make_renderer(
-    std::shared_ptr<BrickSource> source, const std::string& backend, int threads,
-    const std::string& device, bool validation, std::uint64_t device_cache_mb,
-    std::uint64_t host_cache_mb, std::optional<std::uint32_t> loader_threads,
-    const std::string& mode, const std::string& strategy, const std::string& eviction,
-    const std::string& host_eviction, const std::string& output, std::uint32_t prefetch_frames) {
+std::unique_ptr<Renderer> make_renderer(std::shared_ptr<BrickSource> source,
+                                        const std::string& backend, int threads,
+                                        const std::string& device, bool validation,
+                                        std::uint64_t device_cache_mb, std::uint64_t host_cache_mb,
+                                        std::optional<std::uint32_t> loader_threads,
+                                        const std::string& mode, const std::string& strategy,
+                                        const std::string& eviction,
+                                        const std::string& host_eviction, const std::string& output,
+                                        std::uint32_t prefetch_frames, bool brick_errors) {
   ViewerOptions o;
   o.device_cache_bytes = mebibytes(device_cache_mb, "device_cache_mb");
   o.host_cache_bytes = mebibytes(host_cache_mb, "host_cache_mb");
@@ -68,6 +71,7 @@ std::unique_ptr<Renderer> make_renderer(
                             "cannot read; use \"rgba32f\", \"rgba8\" or \"both\"");
   }
   o.prefetch.lookahead_frames = prefetch_frames;
+  o.brick_errors = brick_errors;
   o.validate();  // before a device is created for options that would be refused anyway
   std::unique_ptr<Backend> b = make_named_backend(backend, threads, device, validation);
   py::gil_scoped_release release;  // configuring a device allocates its memory
@@ -144,14 +148,15 @@ void bind_renderer(py::module_& m) {
            py::arg("loader_threads") = py::none(), py::arg("mode") = "residency",
            py::arg("strategy") = "greedy", py::arg("eviction") = "lru",
            py::arg("host_eviction") = "lru", py::arg("output") = "rgba32f",
-           py::arg("prefetch_frames") = 0u,
+           py::arg("prefetch_frames") = 0u, py::arg("brick_errors") = false,
            "backend: 'cpu' (threads: 0 = all cores) or 'vulkan' (device: index or name "
            "substring, '' = best; validation: Khronos validation layers). loader_threads: None "
            "= one per core, 0 = load inside render calls (deterministic). mode: residency, "
            "pagetable or octree; strategy: greedy or global; eviction, host_eviction: lru, "
            "octreemizer (the published priority: distance to the wish list) or "
            "octreemizer-camera (distance from the eye); output: rgba32f, rgba8 or both; "
-           "prefetch_frames: camera lookahead.")
+           "prefetch_frames: camera lookahead; brick_errors: measure coarse bricks' errors "
+           "while loading, for scenes with lod_error_color (error-bounded LOD).")
       .def("render_frame", &render_frame, py::arg("scene"),
            "Renders one frame of a Scene (or scene dict) and returns a Frame.")
       .def("render_until_converged", &render_until_converged, py::arg("scene"),

@@ -6,6 +6,7 @@
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/request_key.glsl.h"
 #include "resoct/render/visible_subtrees.hpp"
+#include "resoct/sources/brick_error.hpp"
 
 namespace resoct::test {
 
@@ -51,16 +52,25 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
             const BrickKey key(l, c, b);
             const BrickMeta meta = source.brick_meta(key);
             const PageAddress a{s, l, b};
+            // The loader's error code (HostBrick::error): level >= 1, measured on the voxels.
+            const auto error_code = [&](std::span<const std::byte> voxels) {
+              return options.brick_errors && l > 0
+                         ? brick_error_code(brick_error(source, key, voxels))
+                         : 0u;
+            };
             if (meta.all_zero()) {
               pages_->set_empty(a);
             } else if (meta.constant && std::isfinite(meta.min)) {
-              pages_->set_homogeneous(a, meta.min, range);
+              std::vector<std::byte> voxels(options.brick_errors && l > 0 ? brick_bytes : 0);
+              if (!voxels.empty()) source.read_brick(key, voxels);
+              pages_->set_homogeneous(a, meta.min, range, error_code(voxels));
             } else {
               const std::uint32_t cache_slot = std::uint32_t(pending.size());
               const std::size_t offset = voxels_.size();
               voxels_.resize(offset + brick_bytes);
-              source.read_brick(key, std::span<std::byte>(voxels_.data() + offset, brick_bytes));
-              pages_->set_mapped(a, cache_slot);
+              const std::span<std::byte> voxels(voxels_.data() + offset, brick_bytes);
+              source.read_brick(key, voxels);
+              pages_->set_mapped(a, cache_slot, error_code(voxels));
               pending.push_back({cache_slot, offset});
             }
             octree_->brick_added(s, l, b);

@@ -31,6 +31,9 @@ struct ResidentOptions {
   bool metadata = true;
   /// Depth that receives metadata; clamped to the leaf depth (the default).
   std::uint32_t metadata_depth = ~0u;
+  /// Give every MAPPED and HOMOGENEOUS entry of level >= 1 its brick_error() code, as the
+  /// renderer's loader does with ViewerOptions::brick_errors (error-bounded LOD).
+  bool brick_errors = false;
 };
 
 class ResidentScene {

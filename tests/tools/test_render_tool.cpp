@@ -185,6 +185,29 @@ TEST(RenderTool, ReportAccuracyComparesWithTheDenseReference) {
   EXPECT_GT(rmse[4.0], 2.0 * rmse[0.5]);
 }
 
+// --lod-error-color: error-bounded LOD from the command line. The loader measures the coarse
+// bricks' errors, so a coarse colour error converges with fewer bricks than the footprint, and
+// its error against the dense reference is larger than the footprint's (the reference is level 0).
+TEST(RenderTool, LodErrorColorTradesBricksForError) {
+  TempDir dir;
+  std::map<std::string, nlohmann::json> stats_of;
+  for (const std::string extra : {"", " --lod-error-color 0.5"}) {
+    const std::string png = dir.file("a.png"), stats = dir.file("a.json");
+    const ToolRun r = run(dir, RESOCT_RENDER,
+                          render_args("procedural:sphere:48x48x48", scene("sphere"), png, stats) +
+                              " --report-accuracy" + extra);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    stats_of[extra] = nlohmann::json::parse(slurp(stats));
+    EXPECT_TRUE(stats_of[extra]["converged"].get<bool>()) << extra;
+  }
+  const nlohmann::json& footprint = stats_of[""];
+  const nlohmann::json& eb = stats_of[" --lod-error-color 0.5"];
+  EXPECT_LT(eb["bricks_uploaded"].get<std::uint64_t>(),
+            footprint["bricks_uploaded"].get<std::uint64_t>());
+  EXPECT_GT(eb["accuracy"]["rmse_rgb"].get<double>(),
+            footprint["accuracy"]["rmse_rgb"].get<double>());
+}
+
 TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
   TempDir dir;
   const std::string png = dir.file("x.png"), stats = dir.file("x.json");
@@ -199,6 +222,8 @@ TEST(RenderTool, BadInputFailsWithOneLineAndLeavesNothing) {
       {render_args(dir.file("absent.rbs"), scene("tubes"), png, stats), "absent.rbs"},
       {render_args(ok_volume, scene("tubes"), png, stats) + " --mode fastest", "mode"},
       {render_args(ok_volume, scene("tubes"), png, stats) + " --backend nosuch", "backend"},
+      {render_args(ok_volume, scene("tubes"), png, stats) + " --lod-error-color 2",
+       "lod-error-color"},
       {render_args(ok_volume, scene("tubes"), dir.file("no/dir/x.png"), stats), "no/dir"},
       // The cells scene shows channels 0-3; a one-channel volume has only channel 0.
       {render_args(ok_volume, scene("cells"), png, stats), "channel"},

@@ -27,6 +27,9 @@ struct HostBrick {
   /// bricks of several timepoints (the shown one, the next one prefetched) live side by side.
   std::uint32_t timepoint = 0;
   BrickMeta meta;
+  /// Down-sampling error in [0, 1] of the channel's range (brick_error()), measured when the
+  /// loader measures errors (level >= 1); 1 = unknown.
+  float error = 1.0f;
   std::vector<std::byte> voxels;  ///< empty when meta.constant
 };
 

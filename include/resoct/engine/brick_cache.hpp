@@ -63,7 +63,7 @@ struct BrickCacheStats {
 class BrickCache {
  public:
   /// Throws Error(invalid_argument) naming "capacity_bytes" when it is 0, smaller than one padded
-  /// brick, or yields more slots than a page entry can address (2^30); the layout is validated.
+  /// brick, or yields more slots than a page entry can address (2^26); the layout is validated.
   /// Error(out_of_memory) when the host cannot hold the bookkeeping. `policy` defaults to
   /// LruPolicy.
   BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t capacity_bytes,

@@ -97,10 +97,13 @@ class BrickLoader {
   /// `host_policy` orders host cache evictions (null: LRU). With a `leaf_layout` (the residency
   /// octree's), every level-0 brick that is not constant is delivered with its leaves' exact
   /// records (LoadedBrick::leaves, scan_leaves over the channel's range), computed on the loading
-  /// thread so that the frame thread only stores them.
+  /// thread so that the frame thread only stores them. With `measure_errors`, every brick of
+  /// level >= 1 is delivered with its down-sampling error (HostBrick::error, brick_error()),
+  /// also measured on the loading thread; it reads the level-0 bricks under the brick.
   BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
               std::uint64_t host_cache_bytes, std::unique_ptr<EvictionPolicy> host_policy = nullptr,
-              std::shared_ptr<const OctreeLayout> leaf_layout = nullptr);
+              std::shared_ptr<const OctreeLayout> leaf_layout = nullptr,
+              bool measure_errors = false);
   /// Stops the workers after their current brick; queued requests are dropped.
   ~BrickLoader();
   BrickLoader(const BrickLoader&) = delete;
@@ -209,6 +212,7 @@ class BrickLoader {
 
   std::shared_ptr<TimepointSources> sources_;
   std::shared_ptr<const OctreeLayout> leaf_layout_;  // set once, before the workers start
+  bool measure_errors_ = false;                      // likewise
   std::shared_ptr<const BrickSource> current_;       // source of timepoint_
   std::uint32_t timepoint_ = 0;
   // Bumped by every switch: a job of an older generation is stale when it completes.

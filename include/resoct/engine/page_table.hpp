@@ -107,7 +107,9 @@ class PageTable {
   /// inside the padded brick. O(1).
   PageLookup translate(std::uint32_t level, std::uint32_t slot, const glm::dvec3& p) const;
 
-  void set_mapped(const PageAddress& a, std::uint32_t cache_slot);
+  /// Maps a brick to a cache slot; `error_code` is its down-sampling error code
+  /// (brick_error_code(); 0 = unknown), which error-bounded LOD reads.
+  void set_mapped(const PageAddress& a, std::uint32_t cache_slot, std::uint32_t error_code = 0);
   /// Marks a brick of only zeros (EMPTY, payload 0).
   void set_empty(const PageAddress& a);
   /// Marks a brick without any finite value (EMPTY, payload 1): transparent whatever the
@@ -116,7 +118,8 @@ class PageTable {
   void set_unmapped(const PageAddress& a);
   /// Marks a constant brick. The device entry holds the value as unorm16 of `range`; the exact
   /// value is kept on the host (homogeneous_value()).
-  void set_homogeneous(const PageAddress& a, double value, const ValueRange& range);
+  void set_homogeneous(const PageAddress& a, double value, const ValueRange& range,
+                       std::uint32_t error_code = 0);
   /// Exact value of a HOMOGENEOUS entry, nullopt for other states.
   std::optional<double> homogeneous_value(const PageAddress& a) const;
 

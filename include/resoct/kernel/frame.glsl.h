@@ -184,6 +184,9 @@ struct ResoctSlotInfo {
   // which all-zero bricks exist. Set for "dvr" channels only.
   uint zero_visible;
   float zero_value;
+  // Error-bounded LOD (kernel/error_lod.glsl.h): a coarser level's brick may stand in for the
+  // LOD's target where its page entry's error code is at least this; 0 = off.
+  uint lod_error_code;
 };
 
 // One brick-hierarchy level.

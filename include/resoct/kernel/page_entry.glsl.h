@@ -3,13 +3,19 @@
 // Layout of an entry (std430-safe: a plain uint in a storage buffer):
 //   bits 30-31  state: UNMAPPED (0), MAPPED (1), EMPTY (2), HOMOGENEOUS (3)
 //   bits  0-29  payload:
-//               MAPPED       cache slot index, 0 .. RESOCT_PAGE_MAX_CACHE_SLOT
+//               MAPPED       bits 0-25 cache slot index, 0 .. RESOCT_PAGE_MAX_CACHE_SLOT;
+//                            bits 26-29 the brick's error code (below)
 //               EMPTY        0: the brick is constant zero (transparent unless the transfer
 //                            function shows 0, ResoctSlotInfo.zero_visible); 1: the brick
 //                            holds no finite value (transparent for every transfer function)
 //               HOMOGENEOUS  bits 0-15 the constant value as unorm16 of the channel's
-//                            value range, bits 16-29 zero
+//                            value range, bits 16-25 zero, bits 26-29 the error code
 //               UNMAPPED     0
+// Error code k (error-bounded level of detail, docs/rendering.md "Error-bounded LOD"): the
+// brick's measured down-sampling error is at most 2^-k of the channel's value range (the largest
+// difference between the level's trilinear reconstruction and the level-0 voxels it summarizes,
+// at their centres). k = 0 says nothing (error up to the whole range: unknown, or level 0 where
+// it is never read); 15 is also what an error of 0 gets.
 // UNMAPPED is the all-zero word so that a zero-filled buffer is a valid, empty page table.
 //
 // Precision of HOMOGENEOUS: the device sees the value quantised to 1/65535 of the channel's value
@@ -28,8 +34,11 @@ RESOCT_CONST(uint, RESOCT_PAGE_STATE_UNMAPPED, 0u);
 RESOCT_CONST(uint, RESOCT_PAGE_STATE_MAPPED, 1u);
 RESOCT_CONST(uint, RESOCT_PAGE_STATE_EMPTY, 2u);
 RESOCT_CONST(uint, RESOCT_PAGE_STATE_HOMOGENEOUS, 3u);
-// Largest cache slot index a MAPPED entry can hold (2^30 - 1, ~1 G bricks).
-RESOCT_CONST(uint, RESOCT_PAGE_MAX_CACHE_SLOT, 0x3FFFFFFFu);
+// Largest cache slot index a MAPPED entry can hold (2^26 - 1, ~64 M bricks).
+RESOCT_CONST(uint, RESOCT_PAGE_MAX_CACHE_SLOT, 0x03FFFFFFu);
+// The error code's place in MAPPED and HOMOGENEOUS entries, and its largest value.
+RESOCT_CONST(uint, RESOCT_PAGE_ERROR_SHIFT, 26u);
+RESOCT_CONST(uint, RESOCT_PAGE_ERROR_MAX, 15u);
 RESOCT_CONST(uint, RESOCT_PAGE_HOMOGENEOUS_MASK, 0xFFFFu);
 RESOCT_CONST(uint, RESOCT_PAGE_UNMAPPED_WORD, 0u);
 RESOCT_CONST(uint, RESOCT_PAGE_EMPTY_WORD, 0x80000000u);
@@ -45,12 +54,25 @@ RESOCT_FN uint resoct_page_payload(uint entry) {
 
 RESOCT_FN uint resoct_page_encode_mapped(uint cache_slot) {
   return (RESOCT_PAGE_STATE_MAPPED << RESOCT_PAGE_STATE_SHIFT) |
-         (cache_slot & RESOCT_PAGE_PAYLOAD_MASK);
+         (cache_slot & RESOCT_PAGE_MAX_CACHE_SLOT);
 }
 
 RESOCT_FN uint resoct_page_encode_homogeneous(uint unorm16) {
   return (RESOCT_PAGE_STATE_HOMOGENEOUS << RESOCT_PAGE_STATE_SHIFT) |
          (unorm16 & RESOCT_PAGE_HOMOGENEOUS_MASK);
+}
+
+// A MAPPED or HOMOGENEOUS entry with error code `code` (0 .. RESOCT_PAGE_ERROR_MAX).
+RESOCT_FN uint resoct_page_with_error(uint entry, uint code) {
+  return entry | (min(code, RESOCT_PAGE_ERROR_MAX) << RESOCT_PAGE_ERROR_SHIFT);
+}
+
+// The error code of a MAPPED or HOMOGENEOUS entry (0 for the other states).
+RESOCT_FN uint resoct_page_error_code(uint entry) {
+  uint state = entry >> RESOCT_PAGE_STATE_SHIFT;
+  return state == RESOCT_PAGE_STATE_MAPPED || state == RESOCT_PAGE_STATE_HOMOGENEOUS
+             ? (entry >> RESOCT_PAGE_ERROR_SHIFT) & RESOCT_PAGE_ERROR_MAX
+             : 0u;
 }
 
 RESOCT_FN bool resoct_page_is_mapped(uint entry) {
@@ -59,7 +81,7 @@ RESOCT_FN bool resoct_page_is_mapped(uint entry) {
 
 // Cache slot of a MAPPED entry (meaningless for other states).
 RESOCT_FN uint resoct_page_cache_slot(uint entry) {
-  return entry & RESOCT_PAGE_PAYLOAD_MASK;
+  return entry & RESOCT_PAGE_MAX_CACHE_SLOT;
 }
 
 // Normalised [0, 1] value of a HOMOGENEOUS entry; EMPTY reads as 0.

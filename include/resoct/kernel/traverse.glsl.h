@@ -41,6 +41,7 @@
 #include "resoct/kernel/composite.glsl.h"
 #include "resoct/kernel/effect_sample.glsl.h"
 #include "resoct/kernel/effects.glsl.h"
+#include "resoct/kernel/error_lod.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/node_class.glsl.h"
 #include "resoct/kernel/node_run.glsl.h"
@@ -258,8 +259,10 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               if (((live >> c) & 1u) == 0u) continue;
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint lc = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
-              cap_level = min(cap_level, lc);
-              RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(lc);
+              // Error-bounded LOD may sample any of the channel's levels (error_lod.glsl.h).
+              cap_level = min(cap_level, resoct_error_bounded_finest(s, lc));
+              RESOCT_IN(ResoctLevelInfo)
+              Lc = resoct_read_level(resoct_error_bounded_coarsest(s, lc));
               coarse_f = max(coarse_f, resoct_level_factor(Lc));
               brick_depth_end =
                   min(brick_depth_end, resoct_brick_depth_end(f, Lc, resoct_frame_brick_size(sp)));
@@ -375,7 +378,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                 src[c] = resoct_source_value(s, float(resoct_node_min16(mm)) / 65535.0f);
                 seg_node_dep = true;
               } else {
-                uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+                uint target = resoct_error_bounded_level(
+                    sp, s, resoct_channel_level(lod, s.finest_level, s.coarsest_level), cell);
                 uint requests_before = stats.requests;
                 src[c] = resoct_residency_source(sp, s, node, class_lo, class_hi, target, cell,
                                                  last_key[c], src_lo, src_hi, stats);
@@ -402,7 +406,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
               if (((live >> c) & 1u) == 0u) continue;
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
-              uint target = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
+              uint target = resoct_error_bounded_level(
+                  sp, s, resoct_channel_level(lod, s.finest_level, s.coarsest_level), cell);
               float exit_c = 0.0f;
               if (mode == RESOCT_MODE_OCTREE) {
                 src[c] = resoct_octree_source(sp, s, target, f.start_depth, cell, frac, inv_vox,

@@ -75,6 +75,11 @@ struct ViewerOptions {
   /// coarser substitute is final). At most 3600000 (one hour).
   std::uint32_t retry_failed_after_ms = 0;
   FrameOutput output = FrameOutput::rgba32f;
+  /// Measure every coarse brick's down-sampling error while loading it (brick_error()), so that
+  /// scenes may choose levels by error (Scene::lod_error_color, docs/rendering.md "Error-bounded
+  /// LOD"). It costs reading the level-0 bricks under each coarse brick on the loader threads;
+  /// off, a scene that asks for error-bounded LOD is refused.
+  bool brick_errors = false;
   /// Throws Error(invalid_argument) naming the field.
   void validate() const;
 };

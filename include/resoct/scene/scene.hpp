@@ -80,7 +80,14 @@ struct Scene {
   std::vector<ChannelSettings> channels;
   double step_scale = 1.0;    ///< step as a multiple of Eq. 8.2-8.3's one-voxel step, > 0
   double lod_error_px = 1.0;  ///< allowed projected voxel size in pixels, > 0
-  double ert_opacity = 0.99;  ///< early termination opacity, in (0, 1]
+  /// Error-bounded level of detail (docs/rendering.md "Error-bounded LOD"), in [0, 1]; 0 = off.
+  /// Each channel samples the coarsest of its levels whose brick's measured down-sampling error,
+  /// times the transfer function's steepest premultiplied-RGBA slope, is at most this (the
+  /// colour error one sample may carry): coarser than lod_error_px would pick where the data is
+  /// smooth, finer where it shows detail; lod_error_px then sets only the step. Needs a renderer
+  /// with ViewerOptions::brick_errors.
+  double lod_error_color = 0.0;
+  double ert_opacity = 0.99;                  ///< early termination opacity, in (0, 1]
   glm::dvec4 background{0.0, 0.0, 0.0, 1.0};  ///< straight-alpha RGBA, each in [0, 1]
   std::vector<Effect> effects;
   /// Pre-integrated transfer functions for DVR channels (docs/rendering.md "Pre-integration").

@@ -68,7 +68,7 @@ BrickCache::BrickCache(const BrickLayout& layout, VoxelType type, std::uint64_t 
   const std::uint64_t slots = capacity_bytes / slot_bytes_;
   if (slots > std::uint64_t(kernel::RESOCT_PAGE_MAX_CACHE_SLOT) + 1u) {
     throw invalid_parameter(
-        "capacity_bytes", std::to_string(slots) + " slots exceed the 2^30 a page entry addresses");
+        "capacity_bytes", std::to_string(slots) + " slots exceed the 2^26 a page entry addresses");
   }
   if (!policy_) policy_ = std::make_unique<LruPolicy>();
   const auto n = std::uint32_t(slots);

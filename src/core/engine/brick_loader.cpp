@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "resoct/base/error.hpp"
+#include "resoct/sources/brick_error.hpp"
 
 namespace resoct {
 
@@ -20,8 +21,10 @@ bool load_before(const LoadRequest& a, const LoadRequest& b) noexcept {
 BrickLoader::BrickLoader(std::shared_ptr<const BrickSource> source, std::uint32_t threads,
                          std::uint64_t host_cache_bytes,
                          std::unique_ptr<EvictionPolicy> host_policy,
-                         std::shared_ptr<const OctreeLayout> leaf_layout)
-    : leaf_layout_(std::move(leaf_layout)), cache_(host_cache_bytes, std::move(host_policy)) {
+                         std::shared_ptr<const OctreeLayout> leaf_layout, bool measure_errors)
+    : leaf_layout_(std::move(leaf_layout)),
+      measure_errors_(measure_errors),
+      cache_(host_cache_bytes, std::move(host_policy)) {
   if (!source) throw invalid_parameter("source", "must not be null");
   sources_ = std::make_shared<TimepointSources>(std::move(source));
   current_ = sources_->series();
@@ -228,6 +231,10 @@ std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& sour
     b->voxels.resize(source.hierarchy().layout().padded_voxels() * voxel_size(type));
     source.read_brick(key, b->voxels);
     b->meta = scan_brick(b->voxels, type);
+    // Measured before a constant brick's voxels go: a HOMOGENEOUS entry carries an error too.
+    if (measure_errors_ && key.level() > 0 && !b->meta.all_zero()) {
+      b->error = float(brick_error(source, key, b->voxels));
+    }
     // A constant brick needs no cache slot, so its voxels are dead weight on the host.
     if (b->meta.constant) std::vector<std::byte>().swap(b->voxels);
     cache_.put(b);

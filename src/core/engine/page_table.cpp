@@ -256,12 +256,16 @@ void PageTable::store(const PageAddress& a, std::uint32_t value) {
   touch(block);
 }
 
-void PageTable::set_mapped(const PageAddress& a, std::uint32_t cache_slot) {
+void PageTable::set_mapped(const PageAddress& a, std::uint32_t cache_slot,
+                           std::uint32_t error_code) {
   if (cache_slot > k::RESOCT_PAGE_MAX_CACHE_SLOT) {
-    throw invalid_parameter("cache_slot", std::to_string(cache_slot) + " exceeds the 30-bit " +
+    throw invalid_parameter("cache_slot", std::to_string(cache_slot) + " exceeds the 26-bit " +
                                               "slot field of a page entry");
   }
-  store(a, k::resoct_page_encode_mapped(cache_slot));
+  if (error_code > k::RESOCT_PAGE_ERROR_MAX) {
+    throw invalid_parameter("error_code", std::to_string(error_code) + " exceeds 15");
+  }
+  store(a, k::resoct_page_with_error(k::resoct_page_encode_mapped(cache_slot), error_code));
 }
 
 void PageTable::set_empty(const PageAddress& a) {
@@ -276,12 +280,16 @@ void PageTable::set_unmapped(const PageAddress& a) {
   store(a, k::RESOCT_PAGE_UNMAPPED_WORD);
 }
 
-void PageTable::set_homogeneous(const PageAddress& a, double value, const ValueRange& range) {
+void PageTable::set_homogeneous(const PageAddress& a, double value, const ValueRange& range,
+                                std::uint32_t error_code) {
   if (!std::isfinite(value)) throw invalid_parameter("value", "homogeneous value must be finite");
+  if (error_code > k::RESOCT_PAGE_ERROR_MAX) {
+    throw invalid_parameter("error_code", std::to_string(error_code) + " exceeds 15");
+  }
   const double span = range.hi - range.lo;
   const double t = span > 0.0 ? std::clamp((value - range.lo) / span, 0.0, 1.0) : 0.0;
   const std::uint32_t q = std::uint32_t(std::lround(t * 65535.0));
-  store(a, k::resoct_page_encode_homogeneous(q));
+  store(a, k::resoct_page_with_error(k::resoct_page_encode_homogeneous(q), error_code));
   // After store(): a HOMOGENEOUS -> HOMOGENEOUS change keeps the value.
   const std::uint32_t block = directory_[directory_index(a)];
   homogeneous_[block * kBlockEntries + k::resoct_page_in_block_index(a.brick)] = value;

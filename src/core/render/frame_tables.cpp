@@ -17,6 +17,7 @@
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/scene/preintegration.hpp"
 #include "resoct/scene/step_lut.hpp"
 #include "resoct/engine/residency_octree.hpp"
@@ -132,6 +133,27 @@ void fill_slot_zero(const ChannelSettings& c, std::span<const glm::vec4> lut,
   const float x = std::clamp(s.zero_value, 0.0f, 1.0f) * float(lut.size() - 1);
   const std::size_t i0 = std::min(std::size_t(x), lut.size() - 2);
   if (lut[i0].a > 0.0f || lut[i0 + 1].a > 0.0f) s.zero_visible = 1u;
+}
+
+// Error-bounded LOD (kernel/error_lod.glsl.h): the least page-entry error code (an error of at
+// most 2^-code of the value range) whose value error, times the LUT's steepest premultiplied
+// RGBA slope per unit of normalized value, stays within `color` (Scene::lod_error_color). 0 =
+// off: asked for none, or no code is fine enough (then the kernel looks nothing up).
+std::uint32_t lod_error_code(double color, std::span<const glm::vec4> lut) {
+  if (!(color > 0.0) || lut.size() < 2) return 0u;
+  double slope = 0.0;
+  for (std::size_t i = 1; i < lut.size(); ++i) {
+    const glm::vec4 a = lut[i - 1], b = lut[i];
+    const glm::vec4 pa(glm::vec3(a) * a.a, a.a), pb(glm::vec3(b) * b.a, b.a);
+    const glm::vec4 d = glm::abs(pb - pa);
+    slope = std::max({slope, double(d.r), double(d.g), double(d.b), double(d.a)});
+  }
+  slope *= double(lut.size() - 1);
+  // A flat transfer function hides every error: any measured one will do.
+  if (!(slope > 0.0)) return 1u;
+  const double code = std::ceil(std::log2(slope / color));
+  if (code > double(kernel::RESOCT_PAGE_ERROR_MAX)) return 0u;
+  return std::uint32_t(std::max(1.0, code));
 }
 
 void fill_slot_effects(const ChannelSettings& c, kernel::ResoctSlotInfo& s) {
@@ -383,6 +405,7 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
       ++out.luts_built;
     }
     fill_slot_zero(c, lut, s);
+    s.lod_error_code = lod_error_code(scene.lod_error_color, lut);
     out.slots.push_back(s);
 
     if (scene.preintegration && out.preint_built[*slot] == 0u) {

@@ -15,6 +15,7 @@
 #include "resoct/engine/prefetch.hpp"
 #include "resoct/engine/request_set.hpp"
 #include "resoct/render/frame_tables.hpp"
+#include "resoct/sources/brick_error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/request_key.glsl.h"
@@ -145,7 +146,8 @@ bool Renderer::Impl::apply_one(const LoadedBrick& b, FrameStats& stats) {
       pages_.set_empty(addr);
       ++stats.pages_empty;
     } else {
-      pages_.set_homogeneous(addr, hb.meta.min, hierarchy_.volume().range(hb.key.channel()));
+      pages_.set_homogeneous(addr, hb.meta.min, hierarchy_.volume().range(hb.key.channel()),
+                             brick_error_code(hb.error));
       ++stats.pages_homogeneous;
     }
     octree_->brick_added(addr.slot, addr.level, addr.brick);
@@ -161,7 +163,7 @@ bool Renderer::Impl::apply_one(const LoadedBrick& b, FrameStats& stats) {
     evict(*ins->evicted);
     ++stats.evictions;
   }
-  pages_.set_mapped(addr, ins->slot);
+  pages_.set_mapped(addr, ins->slot, brick_error_code(hb.error));
   octree_->brick_added(addr.slot, addr.level, addr.brick);
   // A level-0 brick's voxels give its leaves exact culling metadata, often much tighter than the
   // source's region answer (docs/residency-octree.md §4). The loader scanned them on its thread
@@ -493,6 +495,12 @@ void Renderer::Impl::render_frame(const Scene& scene, FrameReport& report,
     throw invalid_parameter("scene", std::to_string(scene.channels.size()) +
                                          " channels exceed the renderer's " +
                                          std::to_string(channels_.slot_count()) + " visible slots");
+  }
+  if (scene.lod_error_color > 0.0 && !options_.brick_errors) {
+    throw invalid_parameter("scene.lod_error_color",
+                            "error-bounded LOD needs bricks with measured errors: create the "
+                            "renderer with ViewerOptions::brick_errors (resoct-render: "
+                            "--lod-error-color sets it)");
   }
   ++frame_;
   cache_->begin_frame(frame_);

@@ -129,7 +129,7 @@ Renderer::Impl::Impl(std::shared_ptr<const BrickSource> source, std::unique_ptr<
   loader_ = std::make_unique<BrickLoader>(
       source_, options_.loader_threads, options_.host_cache_bytes,
       make_host_policy(options_.host_eviction, hierarchy_, host_camera_, wish_list_),
-      std::make_shared<const OctreeLayout>(layout_));
+      std::make_shared<const OctreeLayout>(layout_), options_.brick_errors);
   loader_->set_transient_retry(std::chrono::milliseconds(options_.retry_failed_after_ms));
   timepoint_ = source_->timepoint();
   timepoint_source_ = source_;

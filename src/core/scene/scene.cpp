@@ -371,6 +371,9 @@ void check_scene(const Scene& s, const std::string& what) {
   if (!(s.lod_error_px > 0.0 && s.lod_error_px <= 1e6)) {
     fail("lod_error_px", fmt(s.lod_error_px) + " outside (0, 1e6]");
   }
+  if (!(s.lod_error_color >= 0.0 && s.lod_error_color <= 1.0)) {
+    fail("lod_error_color", fmt(s.lod_error_color) + " outside [0, 1]");
+  }
   if (!(s.ert_opacity > 0.0 && s.ert_opacity <= 1.0)) {
     fail("ert_opacity", fmt(s.ert_opacity) + " outside (0, 1]");
   }
@@ -469,9 +472,9 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   const Reader r(name);
   if (!doc.is_object()) r.fail("(root)", "must be an object");
   r.only_keys(doc, "",
-              {"camera", "viewport", "channels", "step_scale", "lod_error_px", "ert_opacity",
-               "background", "effects", "slices", "lens", "light", "gradient", "shadow_lod_factor",
-               "preintegration", "timepoint"});
+              {"camera", "viewport", "channels", "step_scale", "lod_error_px", "lod_error_color",
+               "ert_opacity", "background", "effects", "slices", "lens", "light", "gradient",
+               "shadow_lod_factor", "preintegration", "timepoint"});
   Scene s;
   s.camera = read_camera(r, r.require(doc, "", "camera"));
   if (const json* v = r.find(doc, "viewport")) s.viewport = read_viewport(r, *v);
@@ -481,6 +484,9 @@ Scene parse_scene(std::string_view json_text, const std::string& name) {
   }
   if (const json* v = r.find(doc, "step_scale")) s.step_scale = r.number(*v, "step_scale");
   if (const json* v = r.find(doc, "lod_error_px")) s.lod_error_px = r.number(*v, "lod_error_px");
+  if (const json* v = r.find(doc, "lod_error_color")) {
+    s.lod_error_color = r.number(*v, "lod_error_color");
+  }
   if (const json* v = r.find(doc, "ert_opacity")) s.ert_opacity = r.number(*v, "ert_opacity");
   if (const json* v = r.find(doc, "background")) s.background = r.vector<4>(*v, "background");
   if (const json* v = r.find(doc, "effects")) {
@@ -550,6 +556,8 @@ std::string scene_to_json(const Scene& s) {
   doc["channels"] = channels;
   doc["step_scale"] = s.step_scale;
   doc["lod_error_px"] = s.lod_error_px;
+  // Written only when on, so that documents of scenes without it are unchanged.
+  if (s.lod_error_color > 0.0) doc["lod_error_color"] = s.lod_error_color;
   doc["ert_opacity"] = s.ert_opacity;
   doc["background"] = vec_json(&s.background.x, 4);
   json effects = json::array();

@@ -14,7 +14,10 @@ using namespace resoct;
 namespace k = resoct::kernel;
 
 static_assert(k::RESOCT_PAGE_PAYLOAD_MASK == (1u << k::RESOCT_PAGE_STATE_SHIFT) - 1u);
-static_assert(k::RESOCT_PAGE_MAX_CACHE_SLOT == k::RESOCT_PAGE_PAYLOAD_MASK);
+// MAPPED: the cache slot below the error code, which ends where the payload does.
+static_assert(k::RESOCT_PAGE_MAX_CACHE_SLOT == (1u << k::RESOCT_PAGE_ERROR_SHIFT) - 1u);
+static_assert(((k::RESOCT_PAGE_ERROR_MAX << k::RESOCT_PAGE_ERROR_SHIFT) |
+               k::RESOCT_PAGE_MAX_CACHE_SLOT) == k::RESOCT_PAGE_PAYLOAD_MASK);
 static_assert(k::RESOCT_PAGE_UNMAPPED_WORD == 0u, "a zero-filled buffer must be an unmapped table");
 static_assert(k::RESOCT_PAGE_EMPTY_WORD == k::RESOCT_PAGE_STATE_EMPTY
                                                << k::RESOCT_PAGE_STATE_SHIFT);
@@ -55,6 +58,24 @@ TEST(KernelLayout, PageEntryRoundTripsAtLimits) {
   EXPECT_EQ(k::resoct_page_state(k::RESOCT_PAGE_EMPTY_WORD), k::RESOCT_PAGE_STATE_EMPTY);
   EXPECT_TRUE(k::resoct_page_is_constant(k::RESOCT_PAGE_EMPTY_WORD));
   EXPECT_EQ(k::resoct_page_homogeneous_value(k::RESOCT_PAGE_EMPTY_WORD), 0.0f);
+  // Error codes ride on MAPPED and HOMOGENEOUS entries without changing slot, value or state.
+  for (std::uint32_t code = 0; code <= k::RESOCT_PAGE_ERROR_MAX; ++code) {
+    for (std::uint32_t slot : {0u, 777u, k::RESOCT_PAGE_MAX_CACHE_SLOT}) {
+      const std::uint32_t e = k::resoct_page_with_error(k::resoct_page_encode_mapped(slot), code);
+      EXPECT_EQ(k::resoct_page_state(e), k::RESOCT_PAGE_STATE_MAPPED);
+      EXPECT_EQ(k::resoct_page_cache_slot(e), slot);
+      EXPECT_EQ(k::resoct_page_error_code(e), code);
+    }
+    for (std::uint32_t v : {0u, 32768u, 65535u}) {
+      const std::uint32_t e = k::resoct_page_with_error(k::resoct_page_encode_homogeneous(v), code);
+      EXPECT_EQ(k::resoct_page_state(e), k::RESOCT_PAGE_STATE_HOMOGENEOUS);
+      EXPECT_FLOAT_EQ(k::resoct_page_homogeneous_value(e), float(v) / 65535.0f);
+      EXPECT_EQ(k::resoct_page_error_code(e), code);
+    }
+  }
+  EXPECT_EQ(k::resoct_page_error_code(k::RESOCT_PAGE_EMPTY_WORD), 0u);
+  EXPECT_EQ(k::resoct_page_error_code(k::RESOCT_PAGE_EMPTY_NAN_WORD), 0u);
+  EXPECT_EQ(k::resoct_page_error_code(k::RESOCT_PAGE_UNMAPPED_WORD), 0u);
   // The four states are distinct words even with payload 0.
   EXPECT_NE(k::resoct_page_encode_mapped(0), k::RESOCT_PAGE_UNMAPPED_WORD);
   EXPECT_NE(k::resoct_page_encode_homogeneous(0), k::RESOCT_PAGE_EMPTY_WORD);
@@ -120,7 +141,16 @@ TEST(KernelLayout, HostKeysAndEntriesUseTheKernelEncoding) {
   EXPECT_EQ(k::resoct_request_key_pool_block(key), block);
   EXPECT_EQ(k::resoct_request_key_in_block(key), 1u);
   EXPECT_EQ(pt.pool()[block * k::RESOCT_PAGE_BLOCK_ENTRIES + 1u], pt.entry(a));
-  // A cache cannot hand out a slot the entry cannot hold: 2^30 slots is its limit (checked before
+  // The error code goes into the entry beside the slot; a slot or code too large is refused.
+  pt.set_mapped(a, 9u, 11u);
+  EXPECT_EQ(pt.entry(a), k::resoct_page_with_error(k::resoct_page_encode_mapped(9u), 11u));
+  EXPECT_RESOCT_ERROR(pt.set_mapped(a, k::RESOCT_PAGE_MAX_CACHE_SLOT + 1u),
+                      ErrorCode::invalid_argument, "cache_slot");
+  EXPECT_RESOCT_ERROR(pt.set_mapped(a, 9u, 16u), ErrorCode::invalid_argument, "error_code");
+  pt.set_homogeneous(a, 0.25, ValueRange{0.0, 1.0}, 3u);
+  EXPECT_EQ(k::resoct_page_error_code(pt.entry(a)), 3u);
+  EXPECT_EQ(pt.homogeneous_value(a), 0.25);
+  // A cache cannot hand out a slot the entry cannot hold: 2^26 slots is its limit (checked before
   // anything is allocated).
   const BrickLayout small{glm::uvec3(4), 0};
   const std::uint64_t slot_bytes = small.padded_voxels();

@@ -1,6 +1,7 @@
 // What RESOCT_KERNEL_LAYOUT_VERSION 5 means (2: ResoctFrame gained the jitter; 4:
 // ResoctLevelInfo gained node_depth, the standard-octree mode's culling node; 5: ResoctFrame
-// gained the step levels of kernel/step_lut.glsl.h): the sizes of the
+// gained the step levels of kernel/step_lut.glsl.h; 6: ResoctSlotInfo gained lod_error_code and
+// MAPPED / HOMOGENEOUS page entries an error code in bits 26-29): the sizes of the
 // records the host shares with the device and the encodings of their packed words. A change to any
 // of them fails here until the version is incremented and this table updated
 // (kernel/layout_version.glsl.h), so applications and backends built against another layout can
@@ -22,12 +23,12 @@ namespace {
 namespace k = resoct::kernel;
 
 TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
-  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 5u)
+  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 6u)
       << "the layout version changed: update the table of this test to the new layout";
   const char* bump = "a shared record changed: increment RESOCT_KERNEL_LAYOUT_VERSION";
   EXPECT_EQ(sizeof(k::ResoctFrame), 524u) << bump;
   EXPECT_EQ(sizeof(k::ResoctFxFrame), 44u) << bump;
-  EXPECT_EQ(sizeof(k::ResoctSlotInfo), 64u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctSlotInfo), 68u) << bump;
   EXPECT_EQ(sizeof(k::ResoctLevelInfo), 44u) << bump;
   EXPECT_EQ(sizeof(k::ResoctDepthInfo), 68u) << bump;
   EXPECT_EQ(sizeof(k::ResoctRayStats), 40u) << bump;
@@ -35,6 +36,8 @@ TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
   EXPECT_EQ(sizeof(OctreeWordDelta), 8u) << bump;
   EXPECT_EQ(k::RESOCT_PAGE_STATE_SHIFT, 30u) << bump;
   EXPECT_EQ(k::RESOCT_PAGE_STATE_HOMOGENEOUS, 3u) << bump;
+  EXPECT_EQ(k::RESOCT_PAGE_ERROR_SHIFT, 26u) << bump;
+  EXPECT_EQ(k::RESOCT_PAGE_MAX_CACHE_SLOT, (1u << 26) - 1u) << bump;
   EXPECT_EQ(k::RESOCT_NODE_WORDS, 4u) << bump;
   EXPECT_EQ(k::RESOCT_NODE_FLAGS, 3u) << bump;
   EXPECT_EQ(k::RESOCT_REQUEST_IN_BLOCK_BITS, 12u) << bump;

@@ -85,6 +85,7 @@ TEST_F(SceneFiles, SaveLoadRoundTrip) {
   s.channels.push_back(extra);
   s.step_scale = 0.1;
   s.lod_error_px = 2.5;
+  s.lod_error_color = 0.03;
   s.ert_opacity = 1.0;
   s.background = {0.1, 0.2, 0.3, 0.4};
   s.effects = {Effect::shadows, Effect::shading};
@@ -151,6 +152,10 @@ TEST_F(SceneFiles, InvalidFieldsNameTheirJsonPath) {
       {R"("step_scale": 1.0)", R"("step_scale": 0)", "scene.json: step_scale: 0 outside"},
       {R"("step_scale": 1.0)", R"("step_scale": -2)", "step_scale: -2 outside"},
       {R"("lod_error_px": 1.0)", R"("lod_error_px": 0)", "lod_error_px: 0 outside"},
+      {R"("lod_error_px": 1.0)", R"("lod_error_px": 1.0, "lod_error_color": -0.1)",
+       "lod_error_color: -0.1 outside [0, 1]"},
+      {R"("lod_error_px": 1.0)", R"("lod_error_px": 1.0, "lod_error_color": 2)",
+       "lod_error_color: 2 outside [0, 1]"},
       {R"("ert_opacity": 0.99)", R"("ert_opacity": 0)", "ert_opacity: 0 outside (0, 1]"},
       {R"("ert_opacity": 0.99)", R"("ert_opacity": 1.01)", "ert_opacity: 1.01 outside (0, 1]"},
       {R"("background": [0, 0, 0, 1])", R"("background": [0, 0, 2, 1])",
