@@ -1,7 +1,8 @@
 // The mask-0 kernel: a scene without effects runs exactly this (see kernel_access.hpp), compiled
 // per render mode and for one channel or several (kernel/effects.glsl.h, RESOCT_FX_MODE and
 // RESOCT_FX_SLOT_COUNT), so that the march of one mode carries no branch of the others and a
-// single-channel frame no channel loop.
+// single-channel frame no channel loop. Frames with error-bounded LOD run the mask-0 kernel that
+// reads mode and channel count at run time.
 #include "kernel_access.hpp"
 
 namespace resoct::cpu::detail {
@@ -23,6 +24,11 @@ RayTotals render_mode(const KernelContext& ctx, const kernel::ResoctFrame& frame
 RayTotals render_plain(const KernelContext& ctx, const kernel::ResoctFrame& frame,
                        glm::vec4* pixels, int threads) {
   using namespace kernel;
+  // Error-bounded LOD lives only in the kernel that is not specialized per mode
+  // (resoct_fx_error_lod), so that the others carry none of its checks.
+  for (std::uint32_t i = 0; i < frame.slot_count; ++i) {
+    if (ctx.slots[i].lod_error_code != 0u) return render_tiles<0u>(ctx, frame, pixels, threads);
+  }
   switch (frame.mode) {
     case RESOCT_MODE_RESIDENCY:
       return render_mode<RESOCT_MODE_RESIDENCY>(ctx, frame, pixels, threads);

@@ -81,6 +81,33 @@ ExactMetaSource wedge() {
   return ExactMetaSource(DenseVolume::from_values(d, v), l);
 }
 
+// Along x: a smooth part that ends with 0.5 at x = 14 (level 1 reconstructs it within 1/4, and
+// smears 0.06 into x = 16), zeros from 15 to 49, and a checkerboard from 50 on (no coarse level
+// within 1/4 there). Seen along -x, the march enters the empty nodes from the checkerboard's
+// side, where level 0 is chosen (level-1 brick x >= 32) and a skip may run on through the empty
+// nodes, into level-1 brick x < 32, where level 1 is chosen and smears into its empty nodes.
+ExactMetaSource edge_and_checker() {
+  VolumeDesc d;
+  d.extent = glm::u64vec3(64);
+  d.type = VoxelType::f32;
+  std::vector<float> v(64 * 64 * 64);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const std::size_t x = i % 64, y = i / 64 % 64, z = i / 4096;
+    double value = 0.0;
+    if (x < 4) {
+      value = 1.0;
+    } else if (x <= 14) {
+      value = 1.0 - 0.5 * double(x - 4) / 10.0;
+    } else if (x >= 50) {
+      value = (x + y + z) % 2 == 0 ? 1.0 : 0.0;
+    }
+    v[i] = float(value);
+  }
+  BrickLayout l;
+  l.brick_size = glm::uvec3(16);
+  return ExactMetaSource(DenseVolume::from_values(d, v), l);
+}
+
 ResidentScene with_errors(const BrickSource& src) {
   ResidentOptions o;
   o.brick_errors = true;
@@ -264,6 +291,30 @@ TEST_P(BackendErrorLod, ModesAgreeWhereACoarseLevelSmearsIntoEmptyNodes) {
       EXPECT_LE(max_diff(r.image, pt.image), 1e-6) << to_string(m) << ", code " << code;
       EXPECT_LE(r.stats.samples, pt.stats.samples) << to_string(m) << ", code " << code;
     }
+  }
+}
+
+TEST_P(BackendErrorLod, ASkipStopsWhereAnotherLevelIsChosen) {
+  // Residency mode's culling holds only where the levels it assumed are chosen: a skip that
+  // starts where level 0 is chosen (no margin) must not run on into a brick that chooses level
+  // 1, whose reconstruction reaches into the empty nodes there.
+  const ExactMetaSource src = edge_and_checker();
+  const ResidentScene rs = with_errors(src);
+  Scene s = blob_scene(true);
+  s.camera.eye = {1.8, 0.52, 0.47};
+  s.ert_opacity = 1.0;
+  s.lod_error_color = 1.0;
+  ASSERT_EQ(rs.tables(s).slots[0].lod_error_code, 2u);
+  FrameOptions o;
+  o.mode = RenderMode::pagetable;
+  const Rendered pt = render(rs, s, o);
+  EXPECT_GT(max_diff(pt.image, render(rs, blob_scene(true), o).image), 1e-3)
+      << "error-bounded LOD must change this image";
+  for (RenderMode m : {RenderMode::residency, RenderMode::octree}) {
+    o.mode = m;
+    const Rendered r = render(rs, s, o);
+    EXPECT_LE(max_diff(r.image, pt.image), 1e-6) << to_string(m);
+    EXPECT_EQ(r.stats.cap_hits, 0u);
   }
 }
 

@@ -76,6 +76,21 @@ class RenderTest(unittest.TestCase):
         self.assertTrue(after.converged)
         self.assertGreater(np.abs(after.image - before).max(), 0.1)
 
+    def test_error_bounded_lod_needs_measured_errors(self):
+        source = resoct.open_source("procedural:sphere:48x48x48")
+        scene = resoct.overview_scene(source, width=48, height=48).to_dict()
+        scene["lod_error_color"] = 0.5
+        with self.assertRaises(resoct.Error) as caught:
+            resoct.Renderer(source, loader_threads=0).render_frame(scene)
+        self.assertIn("lod_error_color", str(caught.exception))
+        # With measured errors a coarse colour error converges on fewer bricks than the footprint.
+        eb = resoct.Renderer(source, loader_threads=0, brick_errors=True)
+        last = eb.render_until_converged(scene)
+        self.assertTrue(last.converged)
+        del scene["lod_error_color"]
+        plain = resoct.Renderer(source, loader_threads=0).render_until_converged(scene)
+        self.assertLess(last.stats["resident_bricks"], plain.stats["resident_bricks"])
+
     def test_png_round_trip(self):
         image = np.zeros((3, 5, 4), dtype=np.float32)
         image[1, 2] = (1.0, 0.5, 0.0, 1.0)

@@ -75,11 +75,20 @@ template <uint E>
 constexpr uint resoct_fx_slot_count(uint frame_slots) {
   return (E & RESOCT_EFFECT_ONE_SLOT) != 0u ? 1u : min(frame_slots, RESOCT_MAX_SLOTS);
 }
+/// Whether a specialization carries error-bounded LOD (kernel/error_lod.glsl.h): every kernel
+/// except the plain ones specialized per mode, which frames that use it never run (the CPU
+/// backend gives them the plain kernel of mask 0), so that its checks cost those nothing.
+template <uint E>
+constexpr bool resoct_fx_error_lod() {
+  return (E >> RESOCT_EFFECT_MODE_SHIFT) == 0u;
+}
 #define RESOCT_FX_MODE(f) resoct_fx_mode<RESOCT_EFFECTS>((f).mode)
 #define RESOCT_FX_SLOT_COUNT(f) resoct_fx_slot_count<RESOCT_EFFECTS>((f).slot_count)
+#define RESOCT_FX_ERROR_LOD (resoct_fx_error_lod<RESOCT_EFFECTS>())
 #else
 #define RESOCT_FX_MODE(f) ((f).mode)
 #define RESOCT_FX_SLOT_COUNT(f) min((f).slot_count, RESOCT_MAX_SLOTS)
+#define RESOCT_FX_ERROR_LOD true
 #endif
 
 // Channel modes (ResoctSlotInfo.mode).

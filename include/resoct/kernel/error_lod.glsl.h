@@ -22,19 +22,26 @@
 
 #include "resoct/kernel/channel_sample.glsl.h"
 #include "resoct/kernel/common.glsl.h"
+#include "resoct/kernel/effects.glsl.h"
 #include "resoct/kernel/frame.glsl.h"
 #include "resoct/kernel/page_entry.glsl.h"
 #include "resoct/kernel/sample.glsl.h"
 
 RESOCT_KERNEL_BEGIN
 
+/// Whether channel `s` chooses its levels by error (its scene asks, and the kernel
+/// specialization carries it: RESOCT_FX_ERROR_LOD, kernel/effects.glsl.h).
+RESOCT_FX_FN bool resoct_error_bounded_on(RESOCT_IN(ResoctSlotInfo) s) {
+  return RESOCT_FX_ERROR_LOD && s.lod_error_code != 0u;
+}
+
 /// The level channel `s` samples at the level-0 cell whose footprint target is `target`:
 /// `target` when error-bounded LOD is off, else the coarsest level in [finest_level,
 /// coarsest_level] whose brick there is UNMAPPED, or MAPPED or HOMOGENEOUS with an error code of
 /// at least s.lod_error_code (finest_level when none is).
-RESOCT_FN uint resoct_error_bounded_level(RESOCT_IN(ResoctSampleParams) f,
-                                          RESOCT_IN(ResoctSlotInfo) s, uint target, ivec3 cell) {
-  if (s.lod_error_code == 0u) return target;
+RESOCT_FX_FN uint resoct_error_bounded_level(RESOCT_IN(ResoctSampleParams) f,
+                                             RESOCT_IN(ResoctSlotInfo) s, uint target, ivec3 cell) {
+  if (!RESOCT_FX(resoct_error_bounded_on)(s)) return target;
   uvec3 bs = resoct_frame_brick_size(f);
   for (uint l = max(s.coarsest_level, s.finest_level); l > s.finest_level; l = l - 1u) {
     RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(l);
@@ -47,14 +54,42 @@ RESOCT_FN uint resoct_error_bounded_level(RESOCT_IN(ResoctSampleParams) f,
   return s.finest_level;
 }
 
+/// Residency mode's culling with error-bounded LOD: the factor of the coarsest level a live
+/// channel (bank `bank`) samples at the cell, the footprint's level `lod` for channels without
+/// the bound, and [lo, hi) clipped to the box where each bounded channel's choice holds: the
+/// chosen level's brick, or where the finest level was chosen because no coarser one
+/// qualifies, the brick of the next coarser level (every position in it finds the same entries
+/// above the finest). The node classes may cull with that factor's margin inside the box;
+/// elsewhere in a culled node a channel could choose a coarser level, whose samples reach
+/// farther.
+RESOCT_FX_FN uvec3 resoct_error_bounded_factor(RESOCT_IN(ResoctSampleParams) f, uint bank, uint n,
+                                               uint live, uint lod, ivec3 cell,
+                                               RESOCT_INOUT(ivec3) lo, RESOCT_INOUT(ivec3) hi) {
+  uvec3 bs = resoct_frame_brick_size(f);
+  uvec3 factor = uvec3(0u);
+  for (uint c = 0u; c < n; ++c) {
+    if (((live >> c) & 1u) == 0u) continue;
+    RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
+    uint l = RESOCT_FX(resoct_error_bounded_level)(
+        f, s, resoct_channel_level(lod, s.finest_level, s.coarsest_level), cell);
+    factor = max(factor, resoct_level_factor(resoct_read_level(l)));
+    if (!RESOCT_FX(resoct_error_bounded_on)(s)) continue;
+    uint holds = l == s.finest_level ? min(l + 1u, max(s.coarsest_level, l)) : l;
+    RESOCT_IN(ResoctLevelInfo) L = resoct_read_level(holds);
+    resoct_box_clip_brick(lo, hi, L, bs, resoct_brick_at(L, bs, cell));
+  }
+  return factor;
+}
+
 /// The finest and the coarsest level channel `s` may sample when its footprint target is
 /// `target`: the target, or with error-bounded LOD the channel's level range (residency mode's
-/// depth cap follows the finest, its culling margin must cover the coarsest).
-RESOCT_FN uint resoct_error_bounded_finest(RESOCT_IN(ResoctSlotInfo) s, uint target) {
-  return s.lod_error_code == 0u ? target : min(target, s.finest_level);
+/// depth cap follows the finest; a node that contains the coarsest's bricks contains the
+/// sources).
+RESOCT_FX_FN uint resoct_error_bounded_finest(RESOCT_IN(ResoctSlotInfo) s, uint target) {
+  return RESOCT_FX(resoct_error_bounded_on)(s) ? min(target, s.finest_level) : target;
 }
-RESOCT_FN uint resoct_error_bounded_coarsest(RESOCT_IN(ResoctSlotInfo) s, uint target) {
-  return s.lod_error_code == 0u ? target : max(target, s.coarsest_level);
+RESOCT_FX_FN uint resoct_error_bounded_coarsest(RESOCT_IN(ResoctSlotInfo) s, uint target) {
+  return RESOCT_FX(resoct_error_bounded_on)(s) ? max(target, s.coarsest_level) : target;
 }
 
 RESOCT_KERNEL_END

@@ -204,6 +204,9 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
   // trilinear support of a level-l sample only this far inside the node (docs/rendering.md
   // "Exact culling").
   ivec3 margin = ivec3(0);
+  // Error-bounded LOD (error_lod.glsl.h): whether a live channel uses it; their levels, and so
+  // the margin, are then known only per decision.
+  bool eb_live = false;
   for (;;) {
     while (t_exit - t > RESOCT_SEGMENT_EPS * dt) {
       if (stats.iterations >= f.max_iterations) {
@@ -254,16 +257,18 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             cap_lod = lod;
             uint cap_level = RESOCT_NONE_U;
             uvec3 coarse_f = uvec3(0u);
+            eb_live = false;
             brick_depth_end = RESOCT_NONE_U;
             for (uint c = 0u; c < n; ++c) {
               if (((live >> c) & 1u) == 0u) continue;
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
               uint lc = resoct_channel_level(lod, s.finest_level, s.coarsest_level);
               // Error-bounded LOD may sample any of the channel's levels (error_lod.glsl.h).
-              cap_level = min(cap_level, resoct_error_bounded_finest(s, lc));
-              RESOCT_IN(ResoctLevelInfo)
-              Lc = resoct_read_level(resoct_error_bounded_coarsest(s, lc));
+              cap_level = min(cap_level, RESOCT_FX(resoct_error_bounded_finest)(s, lc));
+              uint lm = RESOCT_FX(resoct_error_bounded_coarsest)(s, lc);
+              RESOCT_IN(ResoctLevelInfo) Lc = resoct_read_level(lm);
               coarse_f = max(coarse_f, resoct_level_factor(Lc));
+              eb_live = eb_live || RESOCT_FX(resoct_error_bounded_on)(s);
               brick_depth_end =
                   min(brick_depth_end, resoct_brick_depth_end(f, Lc, resoct_frame_brick_size(sp)));
             }
@@ -286,26 +291,39 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           // in the rest of it (the rim) every live channel is looked up, and entering the shrunk
           // part is a new decision.
           uint live_mask = live & (n >= 32u ? 0xFFFFFFFFu : ((1u << n) - 1u));
+          // With error-bounded LOD the margin follows the levels chosen here, and the classes
+          // hold only where those choices do ([eb_lo, eb_hi)).
+          ivec3 dmargin = margin;
+          ivec3 eb_lo = ivec3(-2147483647);
+          ivec3 eb_hi = ivec3(2147483647);
+          if (eb_live) {
+            dmargin = resoct_culling_margin(
+                RESOCT_FX(resoct_error_bounded_factor)(sp, bank, n, live, lod, cell, eb_lo, eb_hi));
+          }
           if (ds.skip_depth != RESOCT_NONE_U) {
             RESOCT_IN(ResoctDepthInfo) Ds = resoct_read_depth(ds.skip_depth);
             ivec3 ne = ivec3(Ds.node_extent_x, Ds.node_extent_y, Ds.node_extent_z);
             class_lo = ivec3(resoct_node_coord(Ds, cell)) * ne;
             class_hi = class_lo + ne;
-            ivec3 ilo = class_lo + margin;
-            ivec3 ihi = class_hi - margin;
+            ivec3 ilo = class_lo + dmargin;
+            ivec3 ihi = class_hi - dmargin;
+            if (eb_live) {
+              ilo = max(ilo, eb_lo);
+              ihi = min(ihi, eb_hi);
+            }
             if (resoct_in_box(cell, ilo, ihi)) {
               skip = true;
               skip_exit = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
               // At level 0 (no margin) the skip goes on through the empty nodes that follow.
-              bool run = all(equal(margin, ivec3(0)));
+              bool run = all(equal(dmargin, ivec3(0)));
               RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
                 run = false;
               }
               if (run) {
-                skip_exit = resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_EMPTY,
-                                                ds.skip_depth, ds.node, resoct_node_coord(Ds, cell),
-                                                class_lo, cell, frac, dir_vox, inv_vox, skip_exit,
-                                                ivec3(-2147483647), ivec3(2147483647), stats);
+                skip_exit =
+                    resoct_node_run_end(f, bank, n, live, RESOCT_NODE_CLASS_EMPTY, ds.skip_depth,
+                                        ds.node, resoct_node_coord(Ds, cell), class_lo, cell, frac,
+                                        dir_vox, inv_vox, skip_exit, eb_lo, eb_hi, stats);
               }
             } else {
               node_t_end = min(resoct_box_exit_t(cell, frac, inv_vox, class_lo, class_hi),
@@ -325,9 +343,13 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
             if (!holds_sources) {
               ivec3 ilo = class_lo;
               ivec3 ihi = class_hi;
-              if ((class_empty | class_homog) != 0u && any(greaterThan(margin, ivec3(0)))) {
-                ilo = ilo + margin;
-                ihi = ihi - margin;
+              if ((class_empty | class_homog) != 0u && any(greaterThan(dmargin, ivec3(0)))) {
+                ilo = ilo + dmargin;
+                ihi = ihi - dmargin;
+              }
+              if ((class_empty | class_homog) != 0u && eb_live) {
+                ilo = max(ilo, eb_lo);
+                ihi = min(ihi, eb_hi);
               }
               if (resoct_in_box(cell, ilo, ihi)) {
                 node_t_end = resoct_box_exit_t(cell, frac, inv_vox, ilo, ihi);
@@ -378,7 +400,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
                 src[c] = resoct_source_value(s, float(resoct_node_min16(mm)) / 65535.0f);
                 seg_node_dep = true;
               } else {
-                uint target = resoct_error_bounded_level(
+                uint target = RESOCT_FX(resoct_error_bounded_level)(
                     sp, s, resoct_channel_level(lod, s.finest_level, s.coarsest_level), cell);
                 uint requests_before = stats.requests;
                 src[c] = resoct_residency_source(sp, s, node, class_lo, class_hi, target, cell,
@@ -406,7 +428,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               src[c] = resoct_source_of(RESOCT_CH_NONE, 0.0f);
               if (((live >> c) & 1u) == 0u) continue;
               RESOCT_IN(ResoctSlotInfo) s = resoct_read_slot(bank + c);
-              uint target = resoct_error_bounded_level(
+              uint target = RESOCT_FX(resoct_error_bounded_level)(
                   sp, s, resoct_channel_level(lod, s.finest_level, s.coarsest_level), cell);
               float exit_c = 0.0f;
               if (mode == RESOCT_MODE_OCTREE) {
