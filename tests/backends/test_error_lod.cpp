@@ -22,23 +22,29 @@ namespace {
 
 namespace k = resoct::kernel;
 
-// A smooth bump, b(r) = max(0, 1 - (r / 12)²)², r in voxels from near the centre, over a floor
-// `floor` (0: empty space around it), in 16³ bricks: 64³ has levels 0..2 and level 2 is one
-// brick.
-InMemorySource blob(float floor) {
+// A 64³ f32 volume in 16³ bricks whose voxel (x, y, z) holds value(x, y, z): 64³ has levels 0..2
+// and level 2 is one brick.
+template <class Source, class Value>
+Source volume64(Value value) {
   VolumeDesc d;
   d.extent = glm::u64vec3(64);
   d.type = VoxelType::f32;
   std::vector<float> v(64 * 64 * 64);
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const glm::dvec3 p(double(i % 64), double(i / 64 % 64), double(i / 4096));
-    const double r = glm::length(p + 0.5 - glm::dvec3(30.0, 33.0, 31.0)) / 12.0;
-    const double b = r < 1.0 ? (1.0 - r * r) * (1.0 - r * r) : 0.0;
-    v[i] = float(floor + (1.0 - floor) * b);
-  }
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = float(value(i % 64, i / 64 % 64, i / 4096));
   BrickLayout l;
   l.brick_size = glm::uvec3(16);
-  return InMemorySource(DenseVolume::from_values(d, v), l);
+  return Source(DenseVolume::from_values(d, v), l);
+}
+
+// A smooth bump, b(r) = max(0, 1 - (r / 12)²)², r in voxels from near the centre, over a floor
+// `floor` (0: empty space around it).
+InMemorySource blob(float floor) {
+  return volume64<InMemorySource>([floor](std::size_t x, std::size_t y, std::size_t z) {
+    const glm::dvec3 p{double(x), double(y), double(z)};
+    const double r = glm::length(p + 0.5 - glm::dvec3(30.0, 33.0, 31.0)) / 12.0;
+    const double b = r < 1.0 ? (1.0 - r * r) * (1.0 - r * r) : 0.0;
+    return floor + (1.0 - floor) * b;
+  });
 }
 
 // An in-memory source whose region metadata is exact to the voxel (the in-memory pyramid's
@@ -69,16 +75,9 @@ class ExactMetaSource : public InMemorySource {
 // voxel more), while level 2's voxel [36, 40) averages the ramp's last values and its
 // reconstruction reaches into them.
 ExactMetaSource wedge() {
-  VolumeDesc d;
-  d.extent = glm::u64vec3(64);
-  d.type = VoxelType::f32;
-  std::vector<float> v(64 * 64 * 64);
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    v[i] = float(std::clamp((38.0 - (double(i % 64) + 0.5)) / 16.0, 0.0, 1.0));
-  }
-  BrickLayout l;
-  l.brick_size = glm::uvec3(16);
-  return ExactMetaSource(DenseVolume::from_values(d, v), l);
+  return volume64<ExactMetaSource>([](std::size_t x, std::size_t, std::size_t) {
+    return std::clamp((38.0 - (double(x) + 0.5)) / 16.0, 0.0, 1.0);
+  });
 }
 
 // Along x: a smooth part that ends with 0.5 at x = 14 (level 1 reconstructs it within 1/4, and
@@ -87,25 +86,11 @@ ExactMetaSource wedge() {
 // side, where level 0 is chosen (level-1 brick x >= 32) and a skip may run on through the empty
 // nodes, into level-1 brick x < 32, where level 1 is chosen and smears into its empty nodes.
 ExactMetaSource edge_and_checker() {
-  VolumeDesc d;
-  d.extent = glm::u64vec3(64);
-  d.type = VoxelType::f32;
-  std::vector<float> v(64 * 64 * 64);
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const std::size_t x = i % 64, y = i / 64 % 64, z = i / 4096;
-    double value = 0.0;
-    if (x < 4) {
-      value = 1.0;
-    } else if (x <= 14) {
-      value = 1.0 - 0.5 * double(x - 4) / 10.0;
-    } else if (x >= 50) {
-      value = (x + y + z) % 2 == 0 ? 1.0 : 0.0;
-    }
-    v[i] = float(value);
-  }
-  BrickLayout l;
-  l.brick_size = glm::uvec3(16);
-  return ExactMetaSource(DenseVolume::from_values(d, v), l);
+  return volume64<ExactMetaSource>([](std::size_t x, std::size_t y, std::size_t z) {
+    if (x < 4) return 1.0;
+    if (x <= 14) return 1.0 - 0.5 * double(x - 4) / 10.0;
+    return x >= 50 && (x + y + z) % 2 == 0 ? 1.0 : 0.0;
+  });
 }
 
 ResidentScene with_errors(const BrickSource& src) {

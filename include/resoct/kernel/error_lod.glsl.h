@@ -15,8 +15,10 @@
 // everywhere in the chosen brick: the decision holds over that brick, images do not depend on
 // where decisions fall, and a converged image does not depend on which other bricks happened
 // to be loaded before. Empty space is culled by the EMPTY bricks the search passes (they never
-// qualify) and, in residency mode, by the octree with the margin of the coarsest level. With
-// lod_error_code 0 it reads nothing.
+// qualify) and, in residency mode, by the octree with the margin of the levels chosen at the
+// decision, inside the box where those choices hold (resoct_error_bounded_factor). With
+// lod_error_code 0 it reads nothing; the per-mode plain kernels of the CPU backend carry none of
+// it (RESOCT_FX_ERROR_LOD).
 #ifndef RESOCT_KERNEL_ERROR_LOD_GLSL_H
 #define RESOCT_KERNEL_ERROR_LOD_GLSL_H
 
