@@ -61,6 +61,18 @@ std::vector<std::uint8_t> with_valid_checksums(const std::uint8_t* data, std::si
     put_crc(b, hdr::index_crc, index, index_size);
   }
   if (inside(meta, meta_size, size)) put_crc(b, hdr::metadata_crc, meta, meta_size);
+  const std::uint64_t flags = get_le(b, hdr::flags, 4);
+  const std::uint64_t channels = get_le(b, hdr::channels, 4);
+  if ((flags & detail::kFlagBrickErrors) != 0 && channels <= kMaxChannels) {
+    const std::uint64_t f = detail::error_fields_at(std::uint32_t(channels), std::uint32_t(flags));
+    if (f + detail::kErrorFieldsSize <= size) {
+      const std::uint64_t errors = get_le(b, f + detail::kErrorFieldOffset, 8);
+      const std::uint64_t errors_size = get_le(b, f + detail::kErrorFieldSize, 8);
+      if (inside(errors, errors_size, size)) {
+        put_crc(b, f + detail::kErrorFieldCrc, errors, errors_size);
+      }
+    }
+  }
   if (hs >= hdr::fixed_size && hs <= size) put_crc(b, hs - 4, 0, hs - 4);
   return b;
 }
@@ -81,6 +93,11 @@ void exercise(const BrickStoreSource& store) {
       (void)m;
       // A damaged payload fails only its own brick; keep reading the others.
       if (!buf.empty()) fuzz::errors_only([&] { store.read_brick(key, buf); });
+      // Stored errors only: measuring would read up to 2^24 level-0 voxels per brick.
+      if (!buf.empty() && stats.brick_errors) {
+        const double e = store.brick_error(key, buf);
+        if (!(e >= 0.0 && e <= 1.0)) fuzz::fail("a stored brick error outside [0, 1]");
+      }
     }
     const Box3 all{glm::i64vec3(0), glm::i64vec3(v.extent)};
     const RegionMeta whole = store.region_meta(c, all);

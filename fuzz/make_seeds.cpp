@@ -72,6 +72,7 @@ struct StoreCase {
   Codec codec;
   int level;
   std::uint32_t metadata_block;
+  bool brick_errors = false;  // the errors section (header flag bit 2)
 };
 
 void store_seeds(const fs::path& scratch, std::vector<Seed>& out) {
@@ -81,6 +82,7 @@ void store_seeds(const fs::path& scratch, std::vector<Seed>& out) {
       {"f32-lz4hc-nan", {6, 6, 5}, 1, VoxelType::f32, {glm::uvec3(4), 2}, Codec::lz4, 9, 8},
       {"u8-zstd-levels", {16, 4, 4}, 1, VoxelType::u8, {{4, 4, 4}, 1}, Codec::zstd, 1, 16},
       {"u8-constant", {9, 9, 9}, 1, VoxelType::u8, {{8, 4, 4}, 0}, Codec::lz4, 0, 4},
+      {"u16-errors-2ch", {16, 8, 8}, 2, VoxelType::u16, {glm::uvec3(4), 1}, Codec::lz4, 0, 4, true},
   };
   fs::create_directories(scratch);
   for (const StoreCase& sc : cases) {
@@ -105,6 +107,7 @@ void store_seeds(const fs::path& scratch, std::vector<Seed>& out) {
     opt.level = sc.level;
     opt.metadata_block = sc.metadata_block;
     opt.threads = 1;
+    opt.brick_errors = sc.brick_errors;
     const fs::path file = scratch / (std::string(sc.name) + ".rbs");
     write_brick_store(src, file.string(), opt);
     out.push_back(

@@ -52,6 +52,7 @@ struct Args {
   std::uint32_t halo = 1;
   int level = 0;
   std::uint32_t metadata_block = 16;
+  bool brick_errors = false;  // --brick-errors: store every brick's down-sampling error
   std::uint32_t threads = 0;
 };
 
@@ -180,6 +181,14 @@ void print_summary(const Args& a, const BrickSource& src, const StoreSummary& s,
       seconds, seconds > 0.0 ? double(input_bytes) / 1e6 / seconds : 0.0,
       std::min(256u,
                a.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : a.threads));
+  if (s.stats.brick_errors) {
+    std::printf("Brick errors stored (fraction of the value range, largest / mean):");
+    for (std::size_t l = 1; l < s.stats.levels.size(); ++l) {
+      std::printf(" level %zu %.3g / %.3g%s", l, s.stats.levels[l].max_error,
+                  s.stats.levels[l].mean_error, l + 1 < s.stats.levels.size() ? "," : ".\n");
+    }
+    if (s.stats.levels.size() < 2) std::printf(" one level, none to store.\n");
+  }
 }
 
 int convert(const Args& a, const CLI::App& app) {
@@ -230,6 +239,7 @@ int convert(const Args& a, const CLI::App& app) {
   w.level = a.level;
   w.metadata_block = a.metadata_block;
   w.threads = a.threads;
+  w.brick_errors = a.brick_errors;
   w.progress = [&](std::uint64_t done, std::uint64_t total) {
     if (!progress) progress = std::make_unique<Progress>("writing " + a.output, total);
     progress->advance(done - reported);
@@ -281,6 +291,10 @@ int main(int argc, char** argv) {
   app.add_option("--metadata-block", a.metadata_block,
                  "metadata pyramid block edge in voxels (power of two, default 16)");
   app.add_option("--threads", a.threads, "worker threads, 0 = all cores (default)");
+  app.add_flag("--brick-errors", a.brick_errors,
+               "store every coarse brick's down-sampling error, so that error-bounded LOD "
+               "(resoct-render --lod-error-color) reads it instead of measuring (reads level 0 "
+               "about three more times)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -63,6 +63,10 @@ json level_json(const BrickHierarchy& h, std::uint32_t l, const StoreStats* stat
     j["empty_fraction"] = s.empty_fraction();
     j["constant_fraction"] =
         s.brick_count == 0 ? 0.0 : double(s.constant_bricks) / double(s.brick_count);
+    if (stats->brick_errors) {
+      j["max_error"] = s.max_error;
+      j["mean_error"] = s.mean_error;
+    }
   }
   return j;
 }
@@ -99,11 +103,10 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
                  {"padded_size", vec(h.layout().padded_size())},
                  {"padded_brick_bytes", padded_brick_bytes(h)}};
   if (stats != nullptr) {
-    j["store"] = {{"codec", std::string(to_string(stats->codec))},
-                  {"codec_level", stats->codec_level},
-                  {"format_version", stats->format_version},
-                  {"file_bytes", stats->file_bytes},
-                  {"metadata_block", store->metadata_block()}};
+    j["store"] = {
+        {"codec", std::string(to_string(stats->codec))}, {"codec_level", stats->codec_level},
+        {"format_version", stats->format_version},       {"file_bytes", stats->file_bytes},
+        {"metadata_block", store->metadata_block()},     {"brick_errors", stats->brick_errors}};
   }
   j["levels"] = json::array();
   for (std::uint32_t l = 0; l < h.level_count(); ++l)
@@ -122,6 +125,10 @@ json describe(const BrickSource& src, const BrickStoreSource* store, SourceKind 
     total["empty_fraction"] = t.empty_fraction();
     total["constant_fraction"] =
         t.brick_count == 0 ? 0.0 : double(t.constant_bricks) / double(t.brick_count);
+    if (stats->brick_errors) {
+      total["max_error"] = t.max_error;
+      total["mean_error"] = t.mean_error;
+    }
   }
   j["total"] = total;
   return j;
@@ -164,10 +171,11 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
               lay.halo, xyz(lay.padded_size()).c_str(),
               format_bytes(padded_brick_bytes(h)).c_str());
   if (stats != nullptr) {
-    std::printf("  store    %s (level %d), format version %u, metadata block %u, file %s\n",
+    std::printf("  store    %s (level %d), format version %u, metadata block %u, file %s%s\n",
                 std::string(to_string(stats->codec)).c_str(), stats->codec_level,
                 stats->format_version, store->metadata_block(),
-                format_bytes(stats->file_bytes).c_str());
+                format_bytes(stats->file_bytes).c_str(),
+                stats->brick_errors ? ", brick errors stored" : "");
   } else if (kind == SourceKind::procedural) {
     std::printf(
         "  (procedural source: bricks are computed on demand, nothing is stored; "
@@ -179,6 +187,7 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
   std::printf("\n%-5s %-17s %-9s %-11s %9s", "level", "extent", "factor", "bricks", "count");
   if (stats != nullptr) {
     std::printf(" %11s %12s %7s %6s %6s", "compressed", "uncompressed", "ratio", "empty", "const");
+    if (stats->brick_errors) std::printf(" %9s %9s", "max error", "mean err.");
   } else {
     std::printf(" %12s", "uncompressed");
   }
@@ -201,6 +210,8 @@ void print_text(const BrickSource& src, const BrickStoreSource* store, SourceKin
       std::printf(" %11s %12s %7s %5.1f%% %5.1f%%", format_bytes(s->compressed_bytes).c_str(),
                   format_bytes(s->uncompressed_bytes).c_str(), ratio_text,
                   100.0 * s->empty_fraction(), 100.0 * constant);
+      // Fractions of the value range (BrickSource::brick_error), when the store holds them.
+      if (stats->brick_errors) std::printf(" %9.3g %9.3g", s->max_error, s->mean_error);
     } else {
       std::printf(" %12s", format_bytes(raw_bytes).c_str());
     }

@@ -4,10 +4,13 @@
 // and a scene that asks for it from a renderer that measures nothing is refused.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
+#include "core/io/store/test_brick_store_util.hpp"
 #include "cpu/cpu_test_util.hpp"
 #include "resoct/cpu/cpu_backend.hpp"
+#include "resoct/io/store/brick_store.hpp"
 #include "resoct/render/renderer.hpp"
 #include "support/expect_error.hpp"
 
@@ -87,6 +90,61 @@ TEST(ErrorLodRender, AViewRefinesToTheResidentImageWithFewerBricks) {
     } else {
       EXPECT_LT(eb_bricks, footprint_bricks) << "colour error " << colour;
     }
+  }
+}
+
+// A source that claims every coarse brick is exact, and counts how often it is asked.
+class ExactClaimSource final : public BrickSource {
+ public:
+  explicit ExactClaimSource(std::shared_ptr<const BrickSource> inner) : inner_(std::move(inner)) {}
+  const BrickHierarchy& hierarchy() const override { return inner_->hierarchy(); }
+  void read_brick(BrickKey key, std::span<std::byte> out) const override {
+    inner_->read_brick(key, out);
+  }
+  RegionMeta region_meta(std::uint32_t c, const Box3& b) const override {
+    return inner_->region_meta(c, b);
+  }
+  double brick_error(BrickKey, std::span<const std::byte>) const override {
+    asked_.fetch_add(1);
+    return 0.0;
+  }
+  std::string name() const override { return "exact-claim"; }
+  int asked() const { return asked_.load(); }
+
+ private:
+  std::shared_ptr<const BrickSource> inner_;
+  mutable std::atomic<int> asked_{0};
+};
+
+TEST(ErrorLodRender, TheLoaderTakesTheErrorsTheSourceGives) {
+  const auto src = std::make_shared<const ExactClaimSource>(sphere());
+  Scene s = sphere_scene();
+  s.lod_error_color = 0.0625;  // needs 71 measured bricks (above)
+  Renderer r(src, cpu::make_backend(1), sync(true));
+  Image got;
+  // Every brick claims error 0, so the coarsest brick qualifies and holds the whole view.
+  EXPECT_EQ(uploads_until_converged(r, s, got), 1u);
+  EXPECT_GE(src->asked(), 1);
+}
+
+TEST(ErrorLodRender, AStoreWithErrorsRendersAsTheMeasuringSource) {
+  const auto procedural = sphere();
+  const TempDir dir;
+  StoreWriteOptions w;
+  w.brick_errors = true;
+  w.threads = 2;
+  write_brick_store(*procedural, dir.file("sphere.rbs"), w);
+  const auto store = std::make_shared<const BrickStoreSource>(dir.file("sphere.rbs"));
+  ASSERT_TRUE(store->stats().brick_errors);
+  for (double colour : {0.125, 0.0625}) {
+    Scene s = sphere_scene();
+    s.lod_error_color = colour;
+    Renderer measured(procedural, cpu::make_backend(1), sync(true));
+    Renderer stored(store, cpu::make_backend(1), sync(true));
+    Image a, b;
+    EXPECT_EQ(uploads_until_converged(stored, s, b), uploads_until_converged(measured, s, a))
+        << "colour error " << colour;
+    EXPECT_EQ(max_diff(a, b), 0.0) << "colour error " << colour;
   }
 }
 

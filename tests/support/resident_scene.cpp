@@ -55,7 +55,7 @@ ResidentScene::ResidentScene(const BrickSource& source, std::vector<std::uint32_
             // The loader's error code (HostBrick::error): level >= 1, measured on the voxels.
             const auto error_code = [&](std::span<const std::byte> voxels) {
               return options.brick_errors && l > 0
-                         ? brick_error_code(brick_error(source, key, voxels))
+                         ? brick_error_code(brick_error_to_float(source.brick_error(key, voxels)))
                          : 0u;
             };
             if (meta.all_zero()) {

@@ -22,6 +22,7 @@
 #include "support/brick_compare.hpp"
 #include "support/tool_process.hpp"
 #include "resoct/io/store/brick_store.hpp"
+#include "resoct/sources/brick_error.hpp"
 #include "resoct/volume/hierarchy.hpp"
 #include "resoct/sources/in_memory_source.hpp"
 #include "resoct/sources/procedural_source.hpp"
@@ -149,6 +150,49 @@ TEST(Tools, InfoJsonMatchesTheStore) {
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("lz4"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("total"), std::string::npos) << text.out;
+}
+
+TEST(Tools, ConvertWithBrickErrorsStoresTheMeasuredErrors) {
+  TempDir dir;
+  const std::string out = dir.file("sphere.rbs");
+  const std::string spec = "procedural:sphere:64x64x64";
+  const ToolRun r = run(dir, RESOCT_CONVERT,
+                        spec + " " + shell_quote(out) + " --brick 16 --brick-errors --threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("Brick errors stored"), std::string::npos) << r.out;
+  const BrickStoreSource store(out);
+  ASSERT_TRUE(store.stats().brick_errors);
+  const ProceduralSource proc(spec, layout_of(16));
+  expect_same_bricks(store, proc);
+  // The errors are the procedural source's own measurements, and level 1 of a sphere is not
+  // exact everywhere.
+  const BrickHierarchy& h = store.hierarchy();
+  std::vector<std::byte> buf(h.layout().padded_voxels() * 4);
+  double largest = 0.0;
+  for (std::uint64_t i = 0; i < h.bricks_per_channel(); ++i) {
+    const BrickKey key = h.key_from_linear(0, i);
+    proc.read_brick(key, buf);
+    const double want = double(brick_error_to_float(proc.brick_error(key, buf)));
+    ASSERT_EQ(store.brick_error(key, buf), want) << "brick " << i;
+    if (key.level() == 1) largest = std::max(largest, want);
+  }
+  EXPECT_GT(largest, 0.0);
+
+  const ToolRun info = run(dir, RESOCT_INFO, shell_quote(out) + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json j = nlohmann::json::parse(info.out);
+  EXPECT_EQ(j["store"]["brick_errors"], true);
+  EXPECT_EQ(j["levels"][1]["max_error"].get<double>(), largest);
+  EXPECT_EQ(j["levels"][0]["max_error"].get<double>(), 0.0);
+  const ToolRun text = run(dir, RESOCT_INFO, shell_quote(out));
+  EXPECT_NE(text.out.find("brick errors stored"), std::string::npos) << text.out;
+  // A store converted without the flag says nothing of errors.
+  const std::string plain = dir.file("plain.rbs");
+  ASSERT_EQ(run(dir, RESOCT_CONVERT, spec + " " + shell_quote(plain) + " --brick 16").exit_code, 0);
+  const nlohmann::json p =
+      nlohmann::json::parse(run(dir, RESOCT_INFO, shell_quote(plain) + " --json").out);
+  EXPECT_EQ(p["store"]["brick_errors"], false);
+  EXPECT_FALSE(p["levels"][1].contains("max_error"));
 }
 
 TEST(Tools, InfoOnAProceduralSourceShowsTheHierarchyOnly) {

@@ -8,11 +8,16 @@
 /// p from the padded brick (the reconstruction the kernel samples), divided by the width of the
 /// channel's value range. Level 0 has error 0. NaN voxels are ignored.
 ///
-/// Where the level-0 voxels under the brick exceed `max_level0_voxels`, they are not read: the
-/// error is bounded instead by the spread (max - min) of the source's region_meta over the core's
-/// level-0 box dilated by one level-l voxel. That bound is valid for every source, since both
-/// r_l(p) and V0(p) are averages of level-0 voxels in that box; it is far above the measured error
-/// where the data is smooth but not constant, so such bricks are rarely coarsened.
+/// The spread (max - min) of the source's region_meta over the core's level-0 box dilated by one
+/// level-l voxel bounds the error for every source, since both r_l(p) and V0(p) are averages of
+/// level-0 voxels in that box. That bound is answered without reading voxels where it already
+/// gives the tightest code (brick_error_code 15; constant regions, empty space give 0), and where
+/// the level-0 voxels under the brick exceed `max_level0_voxels`. Elsewhere it is far above the
+/// measured error where the data is smooth but not constant, so it is not used.
+///
+/// Where the error comes from: BrickSource::brick_error() (a store answers from its file, an
+/// OME-Zarr or other pyramid source measures once and caches); measure_brick_error() below is
+/// the measurement itself.
 
 #include <cstddef>
 #include <cstdint>
@@ -22,7 +27,7 @@
 
 namespace resoct {
 
-/// Level-0 voxels under a brick above which brick_error() bounds instead of measuring: 2^24
+/// Level-0 voxels under a brick above which measure_brick_error() bounds instead of measuring: 2^24
 /// (a 32³ brick up to level 3; 64 MiB of u32 reads at most).
 inline constexpr std::uint64_t kBrickErrorMeasuredVoxels = std::uint64_t(1) << 24;
 
@@ -30,8 +35,17 @@ inline constexpr std::uint64_t kBrickErrorMeasuredVoxels = std::uint64_t(1) << 2
 /// [0, 1] of the channel's value range, or 1 when nothing bounds it (a region without finite
 /// values, an empty range). Reads level-0 bricks of `source`; throws what it throws and
 /// Error(invalid_argument) naming "padded" for a wrongly sized buffer.
-double brick_error(const BrickSource& source, BrickKey key, std::span<const std::byte> padded,
-                   std::uint64_t max_level0_voxels = kBrickErrorMeasuredVoxels);
+double measure_brick_error(const BrickSource& source, BrickKey key,
+                           std::span<const std::byte> padded,
+                           std::uint64_t max_level0_voxels = kBrickErrorMeasuredVoxels);
+
+/// The least float >= `error` (a double), so that keeping an error in 4 bytes (HostBrick::error,
+/// the brick store's error section) never claims a tighter code than the measurement allows.
+/// NaN stays NaN.
+float brick_error_to_float(double error) noexcept;
+
+/// The tightest error code, that of an error of at most 2^-15 (RESOCT_PAGE_ERROR_MAX).
+inline constexpr std::uint32_t kBrickErrorCodeBest = 15;
 
 /// The page entry's error code of an error in [0, 1] (kernel/page_entry.glsl.h): the largest k
 /// in 0..15 with error <= 2^-k; 15 for 0, 0 for errors of 1 or more and for NaN.

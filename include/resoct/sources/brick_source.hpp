@@ -67,6 +67,15 @@ class BrickSource {
   /// can derive it cheaply override this.
   virtual BrickMeta brick_meta(BrickKey key) const;
 
+  /// The down-sampling error of brick `key` in [0, 1] of the channel's value range, as
+  /// measure_brick_error() (sources/brick_error.hpp) defines it, or a bound above it; `padded`
+  /// holds the brick's voxels as read_brick() writes them. Error-bounded level of detail chooses
+  /// levels by it (docs/rendering.md "Error-bounded LOD"). The default measures (reading the
+  /// level-0 bricks under the brick); sources that store the errors (brick stores written with
+  /// them) or cache them (PyramidSource) override it. Throws what read_brick throws, and
+  /// Error(invalid_argument) naming "padded" for a wrongly sized buffer.
+  virtual double brick_error(BrickKey key, std::span<const std::byte> padded) const;
+
   /// Conservative metadata of the level-0 voxels of `channel` inside `level0_region` (clamped
   /// to the volume). Culling relies on this, never on a coarse brick's averaged voxels alone.
   virtual RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const = 0;

@@ -233,7 +233,7 @@ std::shared_ptr<const HostBrick> BrickLoader::read_brick(const BrickSource& sour
     b->meta = scan_brick(b->voxels, type);
     // Measured before a constant brick's voxels go: a HOMOGENEOUS entry carries an error too.
     if (measure_errors_ && key.level() > 0 && !b->meta.all_zero()) {
-      b->error = float(brick_error(source, key, b->voxels));
+      b->error = brick_error_to_float(source.brick_error(key, b->voxels));
     }
     // A constant brick needs no cache slot, so its voxels are dead weight on the host.
     if (b->meta.constant) std::vector<std::byte>().swap(b->voxels);

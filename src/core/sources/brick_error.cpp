@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -66,7 +67,7 @@ class PaddedBrick {
 
 std::uint32_t brick_error_code(double error) noexcept {
   if (!(error < 1.0)) return 0;  // also NaN
-  if (error <= 0.0) return 15;
+  if (error <= 0.0) return kBrickErrorCodeBest;
   // The largest k with error <= 2^-k: floor(-log2(error)), corrected for log2's rounding.
   int k = int(std::floor(-std::log2(error)));
   while (k > 0 && error > std::ldexp(1.0, -k)) --k;
@@ -74,8 +75,14 @@ std::uint32_t brick_error_code(double error) noexcept {
   return std::uint32_t(std::clamp(k, 0, 15));
 }
 
-double brick_error(const BrickSource& source, BrickKey key, std::span<const std::byte> padded,
-                   std::uint64_t max_level0_voxels) {
+float brick_error_to_float(double error) noexcept {
+  const float f = float(error);
+  if (double(f) < error) return std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+double measure_brick_error(const BrickSource& source, BrickKey key,
+                           std::span<const std::byte> padded, std::uint64_t max_level0_voxels) {
   const BrickHierarchy& h = source.hierarchy();
   const BrickLayout& layout = h.layout();
   const VolumeDesc& v = h.volume();
@@ -94,15 +101,20 @@ double brick_error(const BrickSource& source, BrickKey key, std::span<const std:
   const Box3 box0 = h.level0_box(level, key.brick());
   if (box0.empty()) return 0.0;
 
-  if (std::uint64_t(box0.volume()) > max_level0_voxels) {
-    Box3 wide = box0;
-    for (int a = 0; a < 3; ++a) {
-      const std::int64_t step = std::int64_t(1) << li.factor_log2[a];
-      wide.lo[a] = std::max<std::int64_t>(0, box0.lo[a] - step);
-      wide.hi[a] = std::min<std::int64_t>(std::int64_t(v.extent[a]), box0.hi[a] + step);
-    }
-    const double spread = region_spread(source, key.channel(), wide);
-    return spread < 0.0 ? 1.0 : std::min(1.0, spread / span);
+  // The metadata bound (see the header): the spread over the core's level-0 box dilated by one
+  // level-l voxel.
+  Box3 wide = box0;
+  for (int a = 0; a < 3; ++a) {
+    const std::int64_t step = std::int64_t(1) << li.factor_log2[a];
+    wide.lo[a] = std::max<std::int64_t>(0, box0.lo[a] - step);
+    wide.hi[a] = std::min<std::int64_t>(std::int64_t(v.extent[a]), box0.hi[a] + step);
+  }
+  const double spread = region_spread(source, key.channel(), wide);
+  const double bound = spread < 0.0 ? 1.0 : std::min(1.0, spread / span);
+  // Nothing measured could give a better code, or the measurement is too large to make.
+  if (brick_error_code(bound) == kBrickErrorCodeBest ||
+      std::uint64_t(box0.volume()) > max_level0_voxels) {
+    return bound;
   }
 
   const PaddedBrick coarse(padded, layout.padded_size(), v.type);

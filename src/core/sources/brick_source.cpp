@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "resoct/base/error.hpp"
+#include "resoct/sources/brick_error.hpp"
 
 namespace resoct {
 
@@ -41,6 +42,10 @@ BrickMeta scan_brick(std::span<const std::byte> voxels, VoxelType t) {
     case VoxelType::f32: return scan_typed<float>(voxels);
   }
   return {};
+}
+
+double BrickSource::brick_error(BrickKey key, std::span<const std::byte> padded) const {
+  return measure_brick_error(*this, key, padded);
 }
 
 BrickMeta BrickSource::brick_meta(BrickKey key) const {

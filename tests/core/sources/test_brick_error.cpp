@@ -1,4 +1,4 @@
-// brick_error(): the measured down-sampling error of a coarse brick (the largest difference
+// measure_brick_error(): the measured down-sampling error of a coarse brick (the largest difference
 // between the level's trilinear reconstruction and the level-0 voxels, at their centres), its
 // region-spread bound above the budget, and the page entry's error code.
 #include <gtest/gtest.h>
@@ -41,7 +41,7 @@ std::vector<std::byte> padded(const BrickSource& s, BrickKey key) {
 
 double error_of(const BrickSource& s, BrickKey key,
                 std::uint64_t budget = kBrickErrorMeasuredVoxels) {
-  return brick_error(s, key, padded(s, key), budget);
+  return measure_brick_error(s, key, padded(s, key), budget);
 }
 
 // v(x) = (x + 0.5) / 64 along x, constant along y and z.
@@ -115,11 +115,64 @@ TEST(BrickError, AboveTheBudgetTheRegionSpreadBoundsIt) {
   EXPECT_GE(bound, measured);
 }
 
+// Counts level-0 reads of an inner source.
+class Level0Reads final : public BrickSource {
+ public:
+  explicit Level0Reads(const BrickSource& inner) : inner_(inner) {}
+  const BrickHierarchy& hierarchy() const override { return inner_.hierarchy(); }
+  void read_brick(BrickKey key, std::span<std::byte> out) const override {
+    if (key.level() == 0) ++reads;
+    inner_.read_brick(key, out);
+  }
+  RegionMeta region_meta(std::uint32_t c, const Box3& b) const override {
+    return inner_.region_meta(c, b);
+  }
+  std::string name() const override { return "level0-reads"; }
+  mutable int reads = 0;
+
+ private:
+  const BrickSource& inner_;
+};
+
+TEST(BrickError, ConstantRegionsAreAnsweredFromMetadataWithoutReads) {
+  // Zero below x = 32, a ramp above: the coarse brick over the zeros is exact without reading
+  // level 0, the one over the ramp is measured.
+  const glm::u64vec3 e(64, 16, 16);
+  std::vector<float> v(std::size_t(e.x * e.y * e.z));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const double x = double(i % e.x);
+    v[i] = x < 32 ? 0.0f : float((x * x) / 4096.0);
+  }
+  const InMemorySource inner = source_of(e, VoxelType::f32, v);
+  const Level0Reads s(inner);
+  EXPECT_EQ(error_of(s, BrickKey(1, 0, {0, 0, 0})), 0.0);
+  EXPECT_EQ(s.reads, 0);
+  EXPECT_GT(error_of(s, BrickKey(1, 0, {3, 0, 0})), 1e-5);
+  EXPECT_GT(s.reads, 0);
+}
+
+TEST(BrickError, KeptAsFloatItNeverShrinks) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-30.0, 0.0);
+  for (int i = 0; i < 10000; ++i) {
+    const double e = std::exp2(u(rng));
+    const float f = brick_error_to_float(e);
+    ASSERT_GE(double(f), e);
+    ASSERT_LT(double(std::nextafter(f, 0.0f)), e);  // the least such float
+    ASSERT_LE(brick_error_code(double(f)), brick_error_code(e));
+  }
+  EXPECT_EQ(brick_error_to_float(0.0), 0.0f);
+  EXPECT_EQ(brick_error_to_float(std::ldexp(1.0, -7)), std::ldexp(1.0f, -7));
+  EXPECT_TRUE(std::isnan(brick_error_to_float(std::nan(""))));
+  // Rounding to nearest would turn 2^-7 + tiny into exactly 2^-7, whose code claims 7.
+  EXPECT_EQ(brick_error_code(brick_error_to_float(std::ldexp(1.0, -7) * (1 + 1e-12))), 6u);
+}
+
 TEST(BrickError, RejectsAWronglySizedBuffer) {
   const InMemorySource s = ramp();
   std::vector<std::byte> small(10);
-  EXPECT_RESOCT_ERROR(brick_error(s, BrickKey(1, 0, {0, 0, 0}), small), ErrorCode::invalid_argument,
-                      "padded");
+  EXPECT_RESOCT_ERROR(measure_brick_error(s, BrickKey(1, 0, {0, 0, 0}), small),
+                      ErrorCode::invalid_argument, "padded");
 }
 
 }  // namespace

@@ -26,8 +26,9 @@
 namespace resoct {
 
 namespace detail {
-class LazyMetadata;  // on-demand block summaries (src/core/io/formats/lazy_metadata.hpp)
-}
+class LazyMetadata;     // on-demand block summaries (src/core/io/formats/lazy_metadata.hpp)
+class BrickErrorCache;  // measured brick errors (src/core/io/formats/brick_error_cache.hpp)
+}  // namespace detail
 
 /// Fills `out` (dense, x fastest) with the voxels of `box` of one channel of one level; the box
 /// lies inside the level. Must be callable from many threads at once.
@@ -52,6 +53,9 @@ struct PyramidSourceOptions {
   std::uint32_t lazy_query_blocks = 64;
   /// Lazy metadata: cached block summaries (about 48 bytes each); a full cache shard is dropped.
   std::uint64_t lazy_cache_entries = std::uint64_t(1) << 20;
+  /// Measured down-sampling errors kept (brick_error; about 64 bytes each); a full cache shard
+  /// is dropped.
+  std::uint64_t error_cache_entries = std::uint64_t(1) << 20;
   /// Threads of the level-0 passes; 0 = hardware concurrency.
   std::uint32_t threads = 0;
   /// A series whose other timepoints are other sources (a 4-D NIfTI re-read at another
@@ -80,6 +84,9 @@ class PyramidSource : public BrickSource {
   const BrickHierarchy& hierarchy() const override { return hierarchy_; }
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
+  /// Measured on first need (measure_brick_error) and cached per source, so a brick loaded
+  /// again after the host cache evicted it is not measured again.
+  double brick_error(BrickKey key, std::span<const std::byte> padded) const override;
   std::string name() const override { return name_; }
   std::uint32_t timepoints() const override { return timepoints_; }
   std::uint32_t timepoint() const override { return timepoint_; }
@@ -97,6 +104,8 @@ class PyramidSource : public BrickSource {
   bool lazy_metadata() const noexcept { return lazy_ != nullptr; }
   /// Lazy metadata blocks computed so far (0 when eager).
   std::uint64_t lazy_blocks_computed() const noexcept;
+  /// Brick errors measured so far (each miss of the error cache).
+  std::uint64_t brick_errors_measured() const noexcept;
   HostBrickCacheStats cache_stats() const { return cache_->stats(); }
 
  private:
@@ -109,6 +118,7 @@ class PyramidSource : public BrickSource {
   MetadataPyramid pyramid_;
   std::unique_ptr<detail::LazyMetadata> lazy_;
   std::unique_ptr<HostBrickCache> cache_;
+  std::unique_ptr<detail::BrickErrorCache> errors_;
   std::uint32_t timepoints_ = 1;
   std::uint32_t timepoint_ = 0;
   std::function<std::shared_ptr<const BrickSource>(std::uint32_t, const BrickSource&)>

@@ -25,6 +25,13 @@ struct StoreWriteOptions {
   int level = 0;                      ///< codec level; 0 = the codec's default (see Codec)
   std::uint32_t metadata_block = 16;  ///< level-0 voxels per metadata block edge (power of 2)
   std::uint32_t threads = 0;          ///< worker threads reading and compressing; 0 = hardware
+  /// Store every brick's down-sampling error (BrickSource::brick_error of the source, measured
+  /// on the worker threads), so that error-bounded LOD (Scene::lod_error_color) reads it from
+  /// the store instead of measuring each coarse brick as it loads. Measuring reads the level-0
+  /// bricks under every coarse brick of levels 1-3 again (coarser ones, constant and empty
+  /// regions are bounded from metadata), so a conversion takes about that many extra passes
+  /// over level 0 (docs/brick-store-format.md "Errors section").
+  bool brick_errors = false;
   /// Called on the calling thread after each brick is written (done of total bricks, all levels
   /// and channels). May be empty.
   std::function<void(std::uint64_t done, std::uint64_t total)> progress;
@@ -39,6 +46,10 @@ struct StoreLevelStats {
   std::uint64_t empty_bricks = 0;        ///< bricks whose voxels are all zero (BrickMeta::all_zero)
   std::uint64_t compressed_bytes = 0;    ///< payload bytes in the file
   std::uint64_t uncompressed_bytes = 0;  ///< padded voxel bytes of all bricks, constant ones too
+  /// The largest and the mean stored down-sampling error of the level's bricks (0 for level 0);
+  /// both 0 when the store holds no errors (StoreStats::brick_errors).
+  double max_error = 0.0;
+  double mean_error = 0.0;
 
   /// uncompressed_bytes / compressed_bytes (infinity when nothing needed a payload).
   double compression_ratio() const noexcept;
@@ -53,8 +64,9 @@ struct StoreStats {
   int codec_level = 0;
   std::uint32_t format_version = 0;
   std::uint64_t file_bytes = 0;
+  bool brick_errors = false;  ///< the store holds every brick's down-sampling error
 
-  /// Sum over all levels.
+  /// Sum over all levels (errors: the largest, and the mean over all bricks).
   StoreLevelStats total() const noexcept;
 };
 
@@ -102,6 +114,9 @@ class BrickStoreSource final : public BrickSource {
   void read_brick(BrickKey key, std::span<std::byte> out) const override;
   /// From the index; touches no payload.
   BrickMeta brick_meta(BrickKey key) const override;
+  /// The stored error when the store holds errors (stats().brick_errors); else measured
+  /// (BrickSource::brick_error).
+  double brick_error(BrickKey key, std::span<const std::byte> padded) const override;
   /// From the stored level-0 metadata pyramid. Throws invalid_parameter for a bad channel.
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override;
   /// The path or URL the store was opened from.

@@ -64,7 +64,22 @@ inline constexpr std::uint32_t kFlagDefaultRanges = 1u << 0;
 /// before the flag existed; a reader that does not know the flag refuses the file
 /// (Error(unsupported)) instead of silently misplacing it.
 inline constexpr std::uint32_t kFlagOrigin = 1u << 1;
-inline constexpr std::uint32_t kKnownFlags = kFlagDefaultRanges | kFlagOrigin;
+/// Header flag: the store holds every brick's down-sampling error (BrickSource::brick_error): 24
+/// bytes follow the ranges and the origin (the errors section's offset, compressed size and
+/// CRC-32, and a reserved zero word), and the section is one zstd frame of one f32 per brick and
+/// channel, in index order. Set only by a writer asked for errors, so other stores stay
+/// byte-identical to those written before the flag existed.
+inline constexpr std::uint32_t kFlagBrickErrors = 1u << 2;
+inline constexpr std::uint32_t kKnownFlags = kFlagDefaultRanges | kFlagOrigin | kFlagBrickErrors;
+
+/// Bytes of the errors section's header fields (kFlagBrickErrors) and their offsets within them.
+inline constexpr std::uint64_t kErrorFieldsSize = 24;
+inline constexpr std::uint64_t kErrorFieldOffset = 0;     // u64 errors section offset
+inline constexpr std::uint64_t kErrorFieldSize = 8;       // u64 compressed bytes
+inline constexpr std::uint64_t kErrorFieldCrc = 16;       // u32 CRC-32 of the compressed bytes
+inline constexpr std::uint64_t kErrorFieldReserved = 20;  // u32, must be 0
+/// Bytes per brick and channel in the raw errors section (f32).
+inline constexpr std::uint64_t kErrorEntrySize = 4;
 
 /// Index entry flags.
 inline constexpr std::uint32_t kEntryStored = 1u << 0;    ///< a payload exists
@@ -76,7 +91,14 @@ inline constexpr std::uint64_t kIndexEntrySize = 40;
 inline constexpr std::uint64_t kMetaEntrySize = 20;
 
 constexpr std::uint64_t header_size_for(std::uint32_t channels, std::uint32_t flags) noexcept {
-  return hdr::fixed_size + 16u * std::uint64_t(channels) + ((flags & kFlagOrigin) != 0 ? 24u : 0u);
+  return hdr::fixed_size + 16u * std::uint64_t(channels) + ((flags & kFlagOrigin) != 0 ? 24u : 0u) +
+         ((flags & kFlagBrickErrors) != 0 ? kErrorFieldsSize : 0u);
+}
+
+/// Header offset of the errors section's fields (with kFlagBrickErrors): after the ranges and
+/// the origin.
+constexpr std::uint64_t error_fields_at(std::uint32_t channels, std::uint32_t flags) noexcept {
+  return hdr::ranges + 16u * std::uint64_t(channels) + ((flags & kFlagOrigin) != 0 ? 24u : 0u);
 }
 
 struct StoreHeader {
@@ -97,6 +119,10 @@ struct StoreHeader {
   std::uint64_t metadata_raw_size = 0;
   std::uint32_t index_crc = 0;
   std::uint32_t metadata_crc = 0;
+  // The errors section (only with kFlagBrickErrors); its raw size is index_size / 40 * 4.
+  std::uint64_t errors_offset = 0;
+  std::uint64_t errors_size = 0;
+  std::uint32_t errors_crc = 0;
 };
 
 /// Where a brick's voxels are and what they hold. A brick whose voxels are all bitwise equal
@@ -129,5 +155,13 @@ std::vector<std::byte> encode_metadata(const MetadataPyramid& p);
 /// file_error(corrupt, ...) at `offset` when the size does not match.
 void decode_metadata(std::span<const std::byte> raw, MetadataPyramid& p, const std::string& file,
                      std::uint64_t offset);
+
+/// Raw (uncompressed) errors section: one little-endian f32 per brick and channel, index order.
+std::vector<std::byte> encode_errors(std::span<const float> errors);
+/// The errors of a raw errors section, one per index entry (`count`); throws
+/// file_error(corrupt, ...) at `offset` for a wrong size or an error outside [0, 1] (NaN
+/// included), naming the entry.
+std::vector<float> decode_errors(std::span<const std::byte> raw, std::uint64_t count,
+                                 const std::string& file, std::uint64_t offset);
 
 }  // namespace resoct::detail

@@ -76,6 +76,12 @@ class ChannelStack final : public BrickSource {
     const auto [i, c] = owner_[key.channel()];
     return sources_[i]->brick_meta(BrickKey(key.level(), c, key.brick()));
   }
+  // The member source's own answer (stored or cached there); the stack keeps its value ranges.
+  double brick_error(BrickKey key, std::span<const std::byte> padded) const override {
+    check_brick_request(key, padded);
+    const auto [i, c] = owner_[key.channel()];
+    return sources_[i]->brick_error(BrickKey(key.level(), c, key.brick()), padded);
+  }
   RegionMeta region_meta(std::uint32_t channel, const Box3& level0_region) const override {
     if (channel >= owner_.size()) {
       throw Error(ErrorCode::out_of_range, name_ +

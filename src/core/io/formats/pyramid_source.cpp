@@ -4,10 +4,12 @@
 #include <cstring>
 #include <string>
 
+#include "io/formats/brick_error_cache.hpp"
 #include "io/formats/lazy_metadata.hpp"
 #include "io/formats/level0_scan.hpp"
 #include "resoct/volume/downsample.hpp"
 #include "resoct/base/error.hpp"
+#include "resoct/sources/brick_error.hpp"
 
 namespace resoct {
 
@@ -23,6 +25,7 @@ VolumeDesc checked(VolumeDesc desc, const std::vector<LevelBoxReader>& levels,
   }
   if (o.lazy_query_blocks == 0) throw invalid_parameter("lazy_query_blocks", "must be > 0");
   if (o.lazy_cache_entries == 0) throw invalid_parameter("lazy_cache_entries", "must be > 0");
+  if (o.error_cache_entries == 0) throw invalid_parameter("error_cache_entries", "must be > 0");
   return desc;
 }
 
@@ -59,6 +62,7 @@ PyramidSource::PyramidSource(VolumeDesc desc, BrickLayout layout,
       levels_(std::move(levels)),
       name_(std::move(name)),
       cache_(std::make_unique<HostBrickCache>(options.cache_bytes)),
+      errors_(std::make_unique<detail::BrickErrorCache>(options.error_cache_entries)),
       timepoints_(options.timepoints),
       timepoint_(options.timepoint),
       open_timepoint_(std::move(options.open_timepoint)) {
@@ -106,6 +110,16 @@ PyramidSource::~PyramidSource() = default;
 
 std::uint64_t PyramidSource::lazy_blocks_computed() const noexcept {
   return lazy_ ? lazy_->blocks_computed() : 0;
+}
+
+std::uint64_t PyramidSource::brick_errors_measured() const noexcept {
+  return errors_->measured();
+}
+
+double PyramidSource::brick_error(BrickKey key, std::span<const std::byte> padded) const {
+  check_brick_request(key, padded);
+  if (key.level() == 0) return 0.0;
+  return errors_->get(key, [&] { return measure_brick_error(*this, key, padded); });
 }
 
 bool PyramidSource::stored_level(std::uint32_t level) const noexcept {

@@ -97,6 +97,13 @@ std::vector<std::byte> encode_header(const StoreHeader& h) {
     for (int i = 0; i < 3; ++i)
       put_f64(b, hdr::ranges + 16u * channels + 8u * i, h.volume.origin[i]);
   }
+  if ((h.flags & kFlagBrickErrors) != 0) {
+    const std::uint64_t at = error_fields_at(channels, h.flags);
+    put_u64(b, at + kErrorFieldOffset, h.errors_offset);
+    put_u64(b, at + kErrorFieldSize, h.errors_size);
+    put_u32(b, at + kErrorFieldCrc, h.errors_crc);
+    put_u32(b, at + kErrorFieldReserved, 0u);
+  }
   const std::uint64_t crc_at = b.size() - 4;
   put_u32(b, crc_at, crc32(std::span<const std::byte>(b).first(crc_at)));
   return b;
@@ -314,12 +321,33 @@ StoreHeader decode_header(const RandomAccessFile& file) {
                    std::to_string(h.metadata_raw_size) + " bytes");
   }
 
-  Section sections[3] = {
+  const std::uint64_t ef = error_fields_at(channels, h.flags);
+  int section_count = 3;
+  if ((h.flags & kFlagBrickErrors) != 0) {
+    section_count = 4;
+    h.errors_offset = get_u64(b, ef + kErrorFieldOffset);
+    h.errors_size = get_u64(b, ef + kErrorFieldSize);
+    h.errors_crc = get_u32(b, ef + kErrorFieldCrc);
+    if (get_u32(b, ef + kErrorFieldReserved) != 0) {
+      throw fail(ErrorCode::corrupt, ef + kErrorFieldReserved,
+                 "reserved word of the errors section fields is not zero");
+    }
+    // Cannot overflow: the index size (40 bytes per entry) fits in 64 bits.
+    const std::uint64_t raw = h.index_size / kIndexEntrySize * kErrorEntrySize;
+    if (h.errors_size == 0 || raw / kMaxZstdRatio > h.errors_size) {
+      throw fail(ErrorCode::corrupt, ef + kErrorFieldSize,
+                 "compressed errors size " + std::to_string(h.errors_size) + " cannot hold " +
+                     std::to_string(raw) + " bytes");
+    }
+  }
+  const Section sections[4] = {
       {"payload", hdr::payload_offset, h.payload_offset, h.payload_size},
       {"index", hdr::index_offset, h.index_offset, h.index_size},
       {"metadata", hdr::metadata_offset, h.metadata_offset, h.metadata_size},
+      {"errors", ef + kErrorFieldOffset, h.errors_offset, h.errors_size},
   };
-  for (const Section& s : sections) {
+  for (int i = 0; i < section_count; ++i) {
+    const Section& s = sections[i];
     std::uint64_t end = 0;
     if (__builtin_add_overflow(s.offset, s.size, &end) || s.offset < hs) {
       throw fail(ErrorCode::corrupt, s.field,
@@ -333,8 +361,8 @@ StoreHeader decode_header(const RandomAccessFile& file) {
                      ")");
     }
   }
-  for (int i = 0; i < 3; ++i) {
-    for (int j = i + 1; j < 3; ++j) {
+  for (int i = 0; i < section_count; ++i) {
+    for (int j = i + 1; j < section_count; ++j) {
       const Section& a = sections[i];
       const Section& c = sections[j];
       if (a.offset < c.offset + c.size && c.offset < a.offset + a.size) {
@@ -397,6 +425,33 @@ void decode_metadata(std::span<const std::byte> raw, MetadataPyramid& p, const s
     for (RegionMeta& m : f) m.max = get_f64(raw, (off += 8) - 8);
     for (RegionMeta& m : f) m.occupancy = get_u32(raw, (off += 4) - 4);
   }
+}
+
+std::vector<std::byte> encode_errors(std::span<const float> errors) {
+  std::vector<std::byte> b(errors.size() * kErrorEntrySize);
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    put_u32(b, i * kErrorEntrySize, std::bit_cast<std::uint32_t>(errors[i]));
+  }
+  return b;
+}
+
+std::vector<float> decode_errors(std::span<const std::byte> raw, std::uint64_t count,
+                                 const std::string& file, std::uint64_t offset) {
+  if (raw.size() != count * kErrorEntrySize) {
+    throw file_error(ErrorCode::corrupt, file, offset,
+                     "errors section holds " + std::to_string(raw.size()) + " bytes, expected " +
+                         std::to_string(count * kErrorEntrySize));
+  }
+  std::vector<float> out(static_cast<std::size_t>(count));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = std::bit_cast<float>(get_u32(raw, i * kErrorEntrySize));
+    if (!(out[i] >= 0.0f && out[i] <= 1.0f)) {
+      throw file_error(ErrorCode::corrupt, file, offset,
+                       "errors section: the error of brick index entry " + std::to_string(i) +
+                           " is " + std::to_string(out[i]) + ", outside [0, 1]");
+    }
+  }
+  return out;
 }
 
 }  // namespace resoct::detail

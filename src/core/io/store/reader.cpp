@@ -28,15 +28,31 @@ struct BrickStoreSource::Impl {
   StoreHeader header;
   BrickHierarchy hierarchy;
   std::vector<IndexEntry> index;  // channel-major, then BrickHierarchy::linear_index
+  std::vector<float> errors;      // per index entry; empty without kFlagBrickErrors
   MetadataPyramid pyramid;
   StoreStats stats;
 
-  const IndexEntry& entry(BrickKey key) const {
-    return index[std::size_t(std::uint64_t(key.channel()) * hierarchy.bricks_per_channel() +
-                             hierarchy.linear_index(key.level(), key.brick()))];
+  std::size_t slot(BrickKey key) const {
+    return std::size_t(std::uint64_t(key.channel()) * hierarchy.bricks_per_channel() +
+                       hierarchy.linear_index(key.level(), key.brick()));
+  }
+  const IndexEntry& entry(BrickKey key) const { return index[slot(key)]; }
+  // The compressed bytes of a section (inside the file: checked at open), CRC-checked.
+  std::vector<std::byte> read_section(std::uint64_t offset, std::uint64_t size,
+                                      std::uint32_t want_crc, const char* what) const {
+    std::vector<std::byte> packed(static_cast<std::size_t>(size));
+    file.read_at(offset, packed);
+    const std::uint32_t crc = crc32(packed);
+    if (crc != want_crc) {
+      throw file_error(ErrorCode::checksum_mismatch, file.path(), offset,
+                       std::string(what) + " checksum mismatch (stored " +
+                           std::to_string(want_crc) + ", computed " + std::to_string(crc) + ")");
+    }
+    return packed;
   }
   void load_index();
   void load_metadata();
+  void load_errors();
   void compute_stats();
 };
 
@@ -106,19 +122,26 @@ void BrickStoreSource::Impl::load_index() {
 void BrickStoreSource::Impl::load_metadata() {
   const std::string& path = file.path();
   const StoreHeader& h = header;
-  std::vector<std::byte> packed(std::size_t(h.metadata_size));
-  file.read_at(h.metadata_offset, packed);
-  const std::uint32_t crc = crc32(packed);
-  if (crc != h.metadata_crc) {
-    throw file_error(ErrorCode::checksum_mismatch, path, h.metadata_offset,
-                     "metadata checksum mismatch (stored " + std::to_string(h.metadata_crc) +
-                         ", computed " + std::to_string(crc) + ")");
-  }
+  const std::vector<std::byte> packed =
+      read_section(h.metadata_offset, h.metadata_size, h.metadata_crc, "metadata");
   // Raw size was checked against the volume and against zstd's maximum expansion.
   std::vector<std::byte> raw(std::size_t(h.metadata_raw_size));
   decompress_exact(Codec::zstd, packed, raw, path, h.metadata_offset);
   detail::decode_metadata(raw, pyramid, path, h.metadata_offset);
   pyramid.build();
+}
+
+void BrickStoreSource::Impl::load_errors() {
+  const StoreHeader& h = header;
+  if ((h.flags & detail::kFlagBrickErrors) == 0) return;
+  const std::string& path = file.path();
+  const std::vector<std::byte> packed =
+      read_section(h.errors_offset, h.errors_size, h.errors_crc, "errors section");
+  // The raw size follows from the index, which was checked against the volume; its ratio to the
+  // stored bytes was checked against zstd's maximum expansion.
+  std::vector<std::byte> raw(index.size() * detail::kErrorEntrySize);
+  decompress_exact(Codec::zstd, packed, raw, path, h.errors_offset);
+  errors = detail::decode_errors(raw, index.size(), path, h.errors_offset);
 }
 
 void BrickStoreSource::Impl::compute_stats() {
@@ -127,6 +150,7 @@ void BrickStoreSource::Impl::compute_stats() {
   stats.codec_level = header.codec_level;
   stats.format_version = detail::kStoreVersion;
   stats.file_bytes = file.size();
+  stats.brick_errors = !errors.empty();
   stats.levels.resize(hierarchy.level_count());
   const std::uint64_t bpc = hierarchy.bricks_per_channel();
   for (std::uint32_t l = 0; l < hierarchy.level_count(); ++l) {
@@ -136,7 +160,12 @@ void BrickStoreSource::Impl::compute_stats() {
     s.bricks = li.bricks;
     for (std::uint32_t c = 0; c < header.volume.channels; ++c) {
       for (std::uint64_t i = 0; i < li.brick_count; ++i) {
-        const IndexEntry& e = index[std::size_t(c * bpc + li.first_brick + i)];
+        const std::size_t at = std::size_t(c * bpc + li.first_brick + i);
+        const IndexEntry& e = index[at];
+        if (!errors.empty()) {
+          s.max_error = std::max(s.max_error, double(errors[at]));
+          s.mean_error += double(errors[at]);
+        }
         s.brick_count += 1;
         s.uncompressed_bytes += brick_bytes;
         if ((e.flags & detail::kEntryStored) != 0) {
@@ -149,6 +178,7 @@ void BrickStoreSource::Impl::compute_stats() {
         }
       }
     }
+    if (s.brick_count != 0) s.mean_error /= double(s.brick_count);
   }
 }
 
@@ -163,6 +193,7 @@ BrickStoreSource::BrickStoreSource(std::unique_ptr<RandomAccessFile> file) {
     impl_ = std::make_unique<Impl>(std::move(file), h);
     impl_->load_index();
     impl_->load_metadata();
+    impl_->load_errors();
     impl_->compute_stats();
   } catch (const std::bad_alloc&) {
     throw file_error(ErrorCode::out_of_memory, path, 0,
@@ -222,6 +253,12 @@ BrickMeta BrickStoreSource::brick_meta(BrickKey key) const {
   m.max = e.max;
   m.constant = (e.flags & detail::kEntryConstant) != 0;
   return m;
+}
+
+double BrickStoreSource::brick_error(BrickKey key, std::span<const std::byte> padded) const {
+  if (impl_->errors.empty()) return BrickSource::brick_error(key, padded);
+  check_brick_request(key, padded);
+  return double(impl_->errors[impl_->slot(key)]);
 }
 
 RegionMeta BrickStoreSource::region_meta(std::uint32_t channel, const Box3& level0_region) const {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <limits>
 
 #include "resoct/io/store/brick_store.hpp"
@@ -21,7 +22,10 @@ StoreLevelStats StoreStats::total() const noexcept {
     t.empty_bricks += l.empty_bricks;
     t.compressed_bytes += l.compressed_bytes;
     t.uncompressed_bytes += l.uncompressed_bytes;
+    t.max_error = std::max(t.max_error, l.max_error);
+    t.mean_error += l.mean_error * double(l.brick_count);
   }
+  if (t.brick_count != 0) t.mean_error /= double(t.brick_count);
   if (!levels.empty()) {
     t.extent = levels.front().extent;
     t.bricks = levels.front().bricks;

@@ -15,6 +15,7 @@
 #include "resoct/base/file_io.hpp"
 #include "resoct/sources/metadata_pyramid.hpp"
 #include "resoct/io/store/format.hpp"
+#include "resoct/sources/brick_error.hpp"
 
 namespace resoct {
 
@@ -25,6 +26,7 @@ using detail::IndexEntry;
 struct EncodedBrick {
   IndexEntry entry;  // offset filled in when written
   std::vector<std::byte> payload;
+  float error = 0.0f;  // BrickSource::brick_error, with StoreWriteOptions::brick_errors
   std::uint32_t level = 0;
   std::uint64_t slot = 0;  // channel * bricks_per_channel + linear index
 };
@@ -201,6 +203,9 @@ class Pipeline {
     b.entry.max = meta.max;
     b.entry.flags = meta.constant ? detail::kEntryConstant : 0u;
     if (key.level() == 0) add_level0_metadata(h_, key, buf, pyramid_, pyramid_lock_);
+    if (opt_.brick_errors && key.level() > 0) {
+      b.error = brick_error_to_float(src_.brick_error(key, buf));
+    }
     std::uint32_t bits = 0;
     if (bitwise_constant(buf, voxel_size(type), bits)) {
       b.entry.fill_bits = bits;
@@ -263,6 +268,7 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
   hdr.layout = h.layout();
   hdr.flags = vol.ranges.empty() ? detail::kFlagDefaultRanges : 0u;
   if (vol.origin != glm::dvec3(0.0)) hdr.flags |= detail::kFlagOrigin;
+  if (options.brick_errors) hdr.flags |= detail::kFlagBrickErrors;
   hdr.codec = options.codec;
   hdr.codec_level = options.level;
   hdr.metadata_block = options.metadata_block;
@@ -277,6 +283,7 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
   StoreSummary summary;
   summary.stats.levels = empty_level_stats(h);
   std::vector<detail::IndexEntry> index(std::size_t(h.bricks_per_channel() * vol.channels));
+  std::vector<float> errors(options.brick_errors ? index.size() : 0);
   {
     Pipeline pipe(src, options, pyramid, threads);
     const std::uint64_t total = pipe.total();
@@ -297,6 +304,11 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
         ls.empty_bricks += 1;
       }
       index[std::size_t(b.slot)] = b.entry;
+      if (!errors.empty()) {
+        errors[std::size_t(b.slot)] = b.error;
+        ls.max_error = std::max(ls.max_error, double(b.error));
+        ls.mean_error += double(b.error);
+      }
       ++done;
       if (options.progress) options.progress(done, total);
     }
@@ -322,6 +334,18 @@ StoreSummary write_brick_store(const BrickSource& src, const std::string& path,
   hdr.metadata_raw_size = raw_meta.size();
   hdr.metadata_crc = crc32(meta);
   out.append(meta);
+
+  if (!errors.empty()) {
+    const std::vector<std::byte> packed = compress(Codec::zstd, 0, detail::encode_errors(errors));
+    hdr.errors_offset = out.position();
+    hdr.errors_size = packed.size();
+    hdr.errors_crc = crc32(packed);
+    out.append(packed);
+    summary.stats.brick_errors = true;
+    for (StoreLevelStats& ls : summary.stats.levels) {
+      if (ls.brick_count != 0) ls.mean_error /= double(ls.brick_count);
+    }
+  }
 
   out.write_at(0, detail::encode_header(hdr));
   summary.stats.codec = options.codec;

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "resoct/base/error.hpp"
+#include "resoct/io/formats/channel_stack.hpp"
 #include "resoct/io/formats/pyramid_source.hpp"
+#include "resoct/sources/brick_error.hpp"
 #include "resoct/sources/in_memory_source.hpp"
 #include "support/brick_compare.hpp"
 #include "support/expect_error.hpp"
@@ -126,6 +128,35 @@ TEST(PyramidSource, CacheServesRepeatedCoarseReads) {
   EXPECT_EQ(second.insertions, first.insertions);
 }
 
+// OME-Zarr, NIfTI, NRRD and TIFF sources are PyramidSources: a coarse brick's error is measured
+// once per source and then answered from the cache, however often the brick loads again.
+TEST(PyramidSource, BrickErrorsAreMeasuredOnceAndCached) {
+  const DenseVolume v = random_volume({32, 32, 32}, VoxelType::u8, 2, 9);
+  const std::shared_ptr<const PyramidSource> s =
+      make_dense_pyramid_source(v, BrickLayout{glm::uvec3(8), 1}, "e");
+  std::vector<std::byte> out(s->hierarchy().layout().padded_voxels());
+  const BrickKey key(1, 1, {1, 0, 1});
+  s->read_brick(key, out);
+  const double want = measure_brick_error(*s, key, out);
+  EXPECT_GT(want, 0.0);
+  EXPECT_EQ(s->brick_error(key, out), want);
+  EXPECT_EQ(s->brick_errors_measured(), 1u);
+  EXPECT_EQ(s->brick_error(key, out), want);
+  EXPECT_EQ(s->brick_errors_measured(), 1u);
+  EXPECT_EQ(s->brick_error(BrickKey(0, 1, {1, 0, 1}), out), 0.0);  // level 0: nothing to measure
+  EXPECT_EQ(s->brick_errors_measured(), 1u);
+  // A stack of channels answers with its member's own (cached) value.
+  const std::shared_ptr<const BrickSource> other = make_dense_pyramid_source(
+      random_volume({32, 32, 32}, VoxelType::u8, 1, 4), BrickLayout{glm::uvec3(8), 1}, "o");
+  const auto stack = stack_channels({other, s}, "stack");
+  EXPECT_EQ(stack->brick_error(BrickKey(1, 2, {1, 0, 1}), out), want);
+  EXPECT_EQ(s->brick_errors_measured(), 1u);
+  std::vector<std::byte> small(3);
+  EXPECT_RESOCT_ERROR(s->brick_error(key, small), ErrorCode::invalid_argument, "out");
+  EXPECT_RESOCT_ERROR(stack->brick_error(BrickKey(1, 3, {0, 0, 0}), out), ErrorCode::out_of_range,
+                      "stack");
+}
+
 TEST(PyramidSource, RangesFromData) {
   VolumeDesc d;
   d.extent = {5, 4, 3};
@@ -153,6 +184,10 @@ TEST(PyramidSource, BadArguments) {
   o.metadata_block = 12;
   EXPECT_RESOCT_ERROR(make_dense_pyramid_source(v, {}, "x", o), ErrorCode::invalid_argument,
                       "metadata_block");
+  o.metadata_block = 16;
+  o.error_cache_entries = 0;
+  EXPECT_RESOCT_ERROR(make_dense_pyramid_source(v, {}, "x", o), ErrorCode::invalid_argument,
+                      "error_cache_entries");
   const auto s = make_dense_pyramid_source(v, BrickLayout{glm::uvec3(4), 1}, "x");
   std::vector<std::byte> out(8);
   EXPECT_RESOCT_ERROR(s->read_level_box(0, 0, Box3{{0, 0, 0}, {2, 2, 3}}, out),
