@@ -39,7 +39,8 @@ FunctionSource source(VoxelType type = VoxelType::u8) {
   v.type = type;
   return FunctionSource(v, BrickLayout{glm::uvec3(8), 1},
                         [type](std::uint32_t c, const glm::u64vec3& p) {
-                          if (p.z >= 16 && p.y < 8) return 77.0 * (type == VoxelType::f32 ? 0.01 : 1);
+                          if (p.z >= 16 && p.y < 8)
+                            return 77.0 * (type == VoxelType::f32 ? 0.01 : 1);
                           return test::test_value(type, c, p, glm::u64vec3(40, 33, 24));
                         });
 }
@@ -83,9 +84,8 @@ TEST(BrickStoreErrors, StoredErrorsAreTheMeasuredOnes) {
     std::size_t nonzero = 0;
     for_each_key(h, [&](BrickKey key) {
       const std::vector<std::byte> voxels = padded(src, key);
-      const float want = key.level() == 0
-                             ? 0.0f
-                             : brick_error_to_float(measure_brick_error(src, key, voxels));
+      const float want =
+          key.level() == 0 ? 0.0f : brick_error_to_float(measure_brick_error(src, key, voxels));
       const double got = store.brick_error(key, voxels);
       ASSERT_EQ(got, double(want)) << "level " << key.level() << " channel " << key.channel();
       max_error[key.level()] = std::max(max_error[key.level()], double(want));
@@ -108,8 +108,10 @@ TEST(BrickStoreErrors, EverythingElseReadsBackAsWithoutThem) {
   EXPECT_FALSE(b.stats().brick_errors);
   // Only the flag, the 24 bytes of section fields and the section itself differ in size.
   const std::vector<std::uint8_t> fw = read_bytes(with), fo = read_bytes(without);
-  EXPECT_EQ(get_le(fw, test::layout::flags, 4), get_le(fo, test::layout::flags, 4) | kFlagBrickErrors);
-  EXPECT_EQ(get_le(fw, test::layout::header_size, 4), get_le(fo, test::layout::header_size, 4) + 24);
+  EXPECT_EQ(get_le(fw, test::layout::flags, 4),
+            get_le(fo, test::layout::flags, 4) | kFlagBrickErrors);
+  EXPECT_EQ(get_le(fw, test::layout::header_size, 4),
+            get_le(fo, test::layout::header_size, 4) + 24);
   for_each_key(src.hierarchy(), [&](BrickKey key) {
     ASSERT_EQ(padded(a, key), padded(b, key));
     ASSERT_EQ(a.brick_meta(key), b.brick_meta(key));
@@ -184,9 +186,11 @@ TEST(BrickStoreErrors, ADamagedSectionIsRefusedNamingTheOffset) {
   const std::vector<float> values = section_values(good);
   {
     const BrickStoreSource store(path);
-    const BrickKey key = src.hierarchy().key_from_linear(1, src.hierarchy().level(1).first_brick + 1);
+    const BrickKey key =
+        src.hierarchy().key_from_linear(1, src.hierarchy().level(1).first_brick + 1);
     EXPECT_EQ(store.brick_error(key, padded(src, key)),
-              double(values[src.hierarchy().bricks_per_channel() + src.hierarchy().level(1).first_brick + 1]));
+              double(values[src.hierarchy().bricks_per_channel() +
+                            src.hierarchy().level(1).first_brick + 1]));
   }
   const std::string bad = dir.file("bad.rbs");
   auto refused = [&](std::vector<std::uint8_t> b, ErrorCode code, const std::string& what) {
@@ -238,6 +242,20 @@ TEST(BrickStoreErrors, ADamagedSectionIsRefusedNamingTheOffset) {
     put_le(b, test::layout::flags, get_le(b, test::layout::flags, 4) | kFlagBrickErrors, 4);
     test::fix_header_crc(b);
     refused(b, ErrorCode::corrupt, "header size");
+  }
+  {  // a valid section with a value no measurement gives: the store answers from the file
+    std::vector<std::uint8_t> b = good;
+    std::vector<float> vals = values;
+    const BrickHierarchy& h = src.hierarchy();
+    const std::uint64_t i = h.bricks_per_channel() + h.level(1).first_brick + 1;
+    vals[std::size_t(i)] = 0.375f;
+    replace_section(b, vals);
+    write_bytes(bad, b);
+    const BrickStoreSource store(bad);
+    const BrickKey key = h.key_from_linear(1, h.level(1).first_brick + 1);
+    const std::vector<std::byte> voxels = padded(src, key);
+    ASSERT_NE(measure_brick_error(src, key, voxels), 0.375);
+    EXPECT_EQ(store.brick_error(key, voxels), 0.375);
   }
   // And the intact file still opens (the copies above did not alias it).
   write_bytes(bad, good);
