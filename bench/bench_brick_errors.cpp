@@ -182,9 +182,8 @@ void BM_StoreWriteErrors(benchmark::State& state) {
   o.brick_errors = state.range(0) != 0;
   const std::string path = (fx.dir / "bench.rbs").string();
   for (auto _ : state) write_brick_store(*fx.memory, path, o);
-  state.counters["seconds_per_store"] =
-      benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate |
-                                  benchmark::Counter::kInvert);
+  state.counters["seconds_per_store"] = benchmark::Counter(
+      1.0, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace
