@@ -19,6 +19,11 @@
 // Counters: ms_frame, working_set_MiB (distinct bricks sampled per frame × padded brick bytes),
 // samples_per_ray, nodes_per_ray, bricks_touched, brick_accesses_per_ray; on residency rows
 // also res_over_pt / res_over_oct (ms) and ws_res_over_pt / ws_res_over_oct (working set).
+//
+//   BM_SkipMinSamples/dataset:<d>/k:<k>
+//     the residency rows of one channel with TuningOptions::skip_min_samples = k (docs/rendering.md
+//     "Visible subtrees"): 0, where the descent looks below every node that hides anything, and
+//     the default; k_over_0 is ms against the k = 0 row of the same process.
 // Octree leaves 16³, or RESOCT_BENCH_LEAF³ (e.g. RESOCT_BENCH_LEAF=32).
 // Sizes: 256³ and 512×512×40 with 256² images (standard), 1024³ and 1024×1024×40 with 512²
 // (--large or RESOCT_BENCH_LARGE=1), 48³ and 64×64×40 with 32² (--smoke or
@@ -107,6 +112,22 @@ void BM_Table1(benchmark::State& state) {
   state.SetLabel(std::string(kNames[dataset]) + "/" + to_string(mode));
 }
 
+void BM_SkipMinSamples(benchmark::State& state) {
+  static std::map<int, FrameAverages> without;
+  const int dataset = int(state.range(0));
+  const int k = int(state.range(1));
+  Rig& rig = rig_for(dataset);
+  const Scene scene = bench_scene(rig, 1u, image_size());
+  const auto tables = orbit_tables(rig, scene, RenderMode::residency, orbit_frames(), float(k));
+  const FrameAverages a = run_frames(state, rig, tables);
+  if (k == 0) without[dataset] = a;
+  const auto base = without.find(dataset);
+  if (k != 0 && base != without.end()) {
+    state.counters["k_over_0"] = a.ratio_ms() / base->second.ratio_ms();
+  }
+  state.SetLabel(std::string(kNames[dataset]) + "/skip_min_samples " + std::to_string(k));
+}
+
 BENCHMARK(BM_Table1)
     ->Apply([](benchmark::internal::Benchmark* b) {
       for (int dataset = 0; dataset < 5; ++dataset) {
@@ -120,6 +141,16 @@ BENCHMARK(BM_Table1)
       }
     })
     ->ArgNames({"dataset", "channels", "mode"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK(BM_SkipMinSamples)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      for (int dataset = 0; dataset < 5; ++dataset) {
+        for (int k : {0, int(kDefaultSkipMinSamples)}) b->Args({dataset, k});
+      }
+    })
+    ->ArgNames({"dataset", "k"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

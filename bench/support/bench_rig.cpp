@@ -186,7 +186,7 @@ std::uint32_t orbit_frames() {
 }
 
 std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, RenderMode mode,
-                                      std::uint32_t frames) {
+                                      std::uint32_t frames, float skip_min_samples) {
   std::vector<FrameTables> out;
   FrameOptions o;
   o.mode = mode;
@@ -195,7 +195,7 @@ std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, Render
     s.camera = orbit_camera(rig.source->hierarchy().volume(),
                             2.0 * std::numbers::pi * double(f) / double(frames));
     o.frame_index = f;
-    out.push_back(rig.resident->tables(s, o));
+    out.push_back(rig.resident->tables(s, o, skip_min_samples));
   }
   return out;
 }

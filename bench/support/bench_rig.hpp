@@ -86,9 +86,11 @@ Scene bench_scene(const Rig& rig, std::uint32_t visible, std::uint32_t image,
 /// Camera positions per orbit: 2 (smoke), 4 (standard), 16 (large).
 std::uint32_t orbit_frames();
 
-/// Frame tables of `frames` camera positions evenly spaced on the orbit.
+/// Frame tables of `frames` camera positions evenly spaced on the orbit; residency-mode tables
+/// carry the visible-subtree bits of `skip_min_samples` (TuningOptions::skip_min_samples).
 std::vector<FrameTables> orbit_tables(const Rig& rig, const Scene& scene, RenderMode mode,
-                                      std::uint32_t frames);
+                                      std::uint32_t frames,
+                                      float skip_min_samples = kDefaultSkipMinSamples);
 
 /// Per-frame averages of a run (benchmark time is per orbit; ms_frame is per frame).
 struct FrameAverages {

@@ -44,11 +44,12 @@ struct Rendered {
 };
 
 inline Rendered render_cpu(const ResidentScene& rs, const Scene& scene,
-                           const FrameOptions& options = {}) {
+                           const FrameOptions& options = {},
+                           float skip_min_samples = kDefaultSkipMinSamples) {
   cpu::CpuBackend backend(1);
   rs.upload(backend);
   FrameResult r;
-  backend.render(rs.tables(scene, options), r);
+  backend.render(rs.tables(scene, options, skip_min_samples), r);
   return {r.image, r.stats, r.brick_requests, r.node_requests};
 }
 

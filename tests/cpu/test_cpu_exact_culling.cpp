@@ -203,7 +203,9 @@ TEST(ExactCulling, WhollyVisibleNodesEndTheDescentWithoutChangingTheImage) {
     o.mode = RenderMode::pagetable;
     const Rendered pt = render_cpu(rs, s, o);
     o.mode = RenderMode::residency;
-    const Rendered res = render_cpu(rs, s, o);
+    // Visible subtrees only where nothing below is hidden (skip_min_samples 0): the descent into
+    // the hidden half is what this test watches.
+    const Rendered res = render_cpu(rs, s, o, 0.0f);
     ASSERT_GT(res.stats.samples, 0u) << what;
     if (hidden_below < 0.2) {
       // Values 60..240 (0.24..0.94): all visible, nothing to skip.
@@ -263,22 +265,18 @@ TEST(ExactCulling, OnlyNodesThatHoldTheBricksEndNoSegment) {
   }
 }
 
-// A voxel checkerboard of 10 and 240 under a transfer function that hides [0, 0.1]: every node's
-// range [10, 240] holds hidden values, so no record proves its node wholly visible
-// (resoct_node_full), yet no node is EMPTY. The frame's visible-subtree bits (built on the host
-// from every node below, render/visible_subtrees.hpp) end the descent at the root: one node per
-// ray instead of a descent per 4³ leaf, the page table's samples and image to the bit. Without
-// the bits the same tables descend to the leaves.
-TEST(ExactCulling, VisibleSubtreesEndTheDescentWhereEveryNodeStraddlesHiddenValues) {
+// A 32³ voxel checkerboard of 10 and 240, in which every node's range straddles the [0, 0.1]
+// that hides_below_a_tenth() hides; octree leaves of 4³.
+VolumeDesc checkerboard_volume() {
   VolumeDesc v;
   v.extent = {32, 32, 32};
   v.type = VoxelType::u8;
-  FunctionSource src(v, bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
-    return (p.x + p.y + p.z) % 2 == 0 ? 240.0 : 10.0;
-  });
-  ResidentOptions ro;
-  ro.leaf_size = glm::uvec3(4);
-  ResidentScene rs(src, {0}, ro);
+  return v;
+}
+double checkerboard(const glm::u64vec3& p) {
+  return (p.x + p.y + p.z) % 2 == 0 ? 240.0 : 10.0;
+}
+Scene hides_below_a_tenth() {
   Scene s = make_scene(40, oblique_camera());
   s.channels = {make_channel(0,
                              {{0.0, {1, 1, 1, 0}},
@@ -286,6 +284,25 @@ TEST(ExactCulling, VisibleSubtreesEndTheDescentWhereEveryNodeStraddlesHiddenValu
                               {0.15, {0.9, 0.6, 0.2, 0.05}},
                               {1.0, {1, 1, 1, 0.2}}},
                              0, 0)};
+  return s;
+}
+ResidentOptions leaves4() {
+  ResidentOptions ro;
+  ro.leaf_size = glm::uvec3(4);
+  return ro;
+}
+
+// A voxel checkerboard of 10 and 240 under a transfer function that hides [0, 0.1]: every node's
+// range [10, 240] holds hidden values, so no record proves its node wholly visible
+// (resoct_node_full), yet no node is EMPTY. The frame's visible-subtree bits (built on the host
+// from every node below, render/visible_subtrees.hpp) end the descent at the root: one node per
+// ray instead of a descent per 4³ leaf, the page table's samples and image to the bit. Without
+// the bits the same tables descend to the leaves.
+TEST(ExactCulling, VisibleSubtreesEndTheDescentWhereEveryNodeStraddlesHiddenValues) {
+  FunctionSource src(checkerboard_volume(), bricks8(),
+                     [](std::uint32_t, const glm::u64vec3& p) { return checkerboard(p); });
+  ResidentScene rs(src, {0}, leaves4());
+  const Scene s = hides_below_a_tenth();
   FrameOptions o;
   o.mode = RenderMode::pagetable;
   const Rendered pt = render_cpu(rs, s, o);
@@ -308,6 +325,45 @@ TEST(ExactCulling, VisibleSubtreesEndTheDescentWhereEveryNodeStraddlesHiddenValu
   EXPECT_EQ(b.stats.samples, pt.stats.samples);
   EXPECT_GT(b.stats.nodes_visited, 2 * b.stats.rays);
   EXPECT_EQ(max_diff(b.image, pt.image), 0.0);
+}
+
+// TuningOptions::skip_min_samples widens the visible-subtree bits over nodes that hide too little
+// for their descent to pay: the checkerboard of the test above with pockets of hidden noise
+// (12³ cells of values 1-3, under the hidden 0.1, not homogeneous), whose inner 4³ leaves are
+// EMPTY (their records reach one voxel past them). The leaves are smaller than the 8³ bricks, so
+// widening over them requests no brick. With an allowance of 0 the pockets' ancestors lose their
+// bits and rays descend to skip them; with larger ones the nodes above keep them and the pockets
+// are sampled, transparent. The image is the page table's, to the bit,
+// for every allowance; only the nodes visited and the samples taken change.
+TEST(ExactCulling, WideningTheVisibleSubtreesChangesWorkNotTheImage) {
+  FunctionSource src(checkerboard_volume(), bricks8(), [](std::uint32_t, const glm::u64vec3& p) {
+    const glm::u64vec3 cell = p / std::uint64_t(12);
+    if (cell.x + cell.y + cell.z == 3) return double(1 + (p.x + p.y + p.z) % 3);
+    return checkerboard(p);
+  });
+  ResidentScene rs(src, {0}, leaves4());
+  const Scene s = hides_below_a_tenth();
+  FrameOptions o;
+  o.mode = RenderMode::pagetable;
+  const Rendered pt = render_cpu(rs, s, o);
+  o.mode = RenderMode::residency;
+  cpu::CpuBackend backend(1);
+  rs.upload(backend);
+  std::vector<FrameResult> results;
+  for (float k : {0.0f, kDefaultSkipMinSamples, 1e6f}) {
+    results.emplace_back();
+    backend.render(rs.tables(s, o, k), results.back());
+    const FrameResult& r = results.back();
+    EXPECT_EQ(max_diff(r.image, pt.image), 0.0) << "skip_min_samples " << k;
+    EXPECT_EQ(r.stats.cap_hits, 0u) << "skip_min_samples " << k;
+  }
+  ASSERT_GT(pt.stats.samples, 0u);
+  EXPECT_LT(results[0].stats.samples, pt.stats.samples) << "0: every pocket is skipped";
+  EXPECT_GT(results[0].stats.nodes_visited, results[2].stats.nodes_visited);
+  EXPECT_LE(results[2].stats.nodes_visited, results[2].stats.rays) << "one node per ray";
+  EXPECT_EQ(results[2].stats.samples, pt.stats.samples) << "every pocket is sampled";
+  EXPECT_LE(results[1].stats.nodes_visited, results[0].stats.nodes_visited);
+  EXPECT_GE(results[1].stats.nodes_visited, results[2].stats.nodes_visited);
 }
 
 // Where a channel samples a coarse level, a node's class holds only inside the node shrunk by

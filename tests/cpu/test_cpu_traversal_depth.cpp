@@ -65,9 +65,11 @@ TEST(CpuTraversalDepth, IncrementalDescentMatchesNodeOwnClassification) {
     const Scene s = three_channel_scene(random_camera(rng));
     FrameOptions o;
     o.mode = RenderMode::residency;
-    const Rendered descent = render_cpu(rs, s, o);
+    // Visible subtrees only where nothing below is hidden (skip_min_samples 0), so that every
+    // empty leaf the flat render skips, the descent skips too.
+    const Rendered descent = render_cpu(rs, s, o, 0.0f);
     o.start_depth = leaf;
-    const Rendered flat = render_cpu(rs, s, o);
+    const Rendered flat = render_cpu(rs, s, o, 0.0f);
     o.mode = RenderMode::pagetable;
     o.start_depth = 0;
     const Rendered pt = render_cpu(rs, s, o);

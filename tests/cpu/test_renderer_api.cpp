@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <set>
 
@@ -89,6 +90,16 @@ TEST(RendererApi, BackendObjectRendersWhatTheRegisteredBackendRenders) {
 TEST(RendererApi, NullBackendIsRejectedNamingIt) {
   EXPECT_RESOCT_ERROR(Renderer(tubes(), std::unique_ptr<Backend>()), ErrorCode::invalid_argument,
                       "backend");
+}
+
+TEST(RendererApi, ASkipThresholdThatIsNoCountOfSamplesIsRejectedNamingIt) {
+  for (float k : {-1.0f, std::numeric_limits<float>::quiet_NaN(),
+                  std::numeric_limits<float>::infinity()}) {
+    RendererOptions o = sync_viewer();
+    o.skip_min_samples = k;
+    EXPECT_RESOCT_ERROR(Renderer(tubes(), cpu::make_backend(1), o), ErrorCode::invalid_argument,
+                        "skip_min_samples");
+  }
 }
 
 TEST(RendererApi, ViewerOptionsKeepTheDefaultTuning) {

@@ -123,10 +123,11 @@ void ResidentScene::upload(Backend& backend) const {
   backend.update(u);
 }
 
-FrameTables ResidentScene::tables(const Scene& scene, const FrameOptions& options) const {
+FrameTables ResidentScene::tables(const Scene& scene, const FrameOptions& options,
+                                  float skip_min_samples) const {
   FrameTables t = build_frame_tables(scene, source_.hierarchy(), layout_, channels_, options);
   // As the Renderer does: residency-mode tables carry the octree's visible-subtree bits.
-  build_visible_subtrees(*octree_, t);
+  build_visible_subtrees(*octree_, t, skip_min_samples);
   return t;
 }
 

@@ -14,6 +14,7 @@
 #include "resoct/sources/brick_source.hpp"
 #include "resoct/engine/channel_map.hpp"
 #include "resoct/render/frame_tables.hpp"
+#include "resoct/render/renderer_options.hpp"
 #include "resoct/engine/octree_layout.hpp"
 #include "resoct/engine/page_table.hpp"
 #include "resoct/engine/residency_octree.hpp"
@@ -50,7 +51,10 @@ class ResidentScene {
 
   /// configure() with sizes that fit, then one full update.
   void upload(Backend& backend) const;
-  FrameTables tables(const Scene& scene, const FrameOptions& options = {}) const;
+  /// build_frame_tables() and, as the Renderer builds them, the visible-subtree bits with
+  /// `skip_min_samples` (TuningOptions::skip_min_samples).
+  FrameTables tables(const Scene& scene, const FrameOptions& options = {},
+                     float skip_min_samples = kDefaultSkipMinSamples) const;
   /// The brick key a device request key names (for asserting requests).
   PageAddress decode(std::uint32_t device_key) const;
 

@@ -85,6 +85,9 @@ struct ViewerOptions {
 };
 
 /// The frame loop's expert knobs; the defaults suit every dataset the tests and benchmarks use.
+/// TuningOptions::skip_min_samples unless set: measured on Table 1 (bench/README.md).
+inline constexpr float kDefaultSkipMinSamples = 12.0f;
+
 struct TuningOptions {
   /// Visible channel slots of the page table and octree; 0 = the dataset's channel count,
   /// capped at RESOCT_MAX_SLOTS (32).
@@ -105,6 +108,12 @@ struct TuningOptions {
   std::uint32_t max_node_answers = 16384;
   std::uint32_t max_iterations = 1u << 20;  ///< march iterations per ray (cap)
   std::uint32_t start_depth = 2;
+  /// Residency mode: the fewest samples a ray must save in a node's hidden space for the descent
+  /// to look below that node (docs/rendering.md "Visible subtrees"). Where what a subtree hides
+  /// would save fewer samples than the decisions that find it cost, the node is marched whole and
+  /// its few hidden samples are taken (transparent: the image is the same). 0 = look below every
+  /// node that hides anything. Must be finite and >= 0.
+  float skip_min_samples = kDefaultSkipMinSamples;
   /// Throws Error(invalid_argument) naming the field.
   void validate() const;
 };

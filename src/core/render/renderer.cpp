@@ -440,7 +440,7 @@ const FrameTables& Renderer::Impl::frame_tables(const Scene& scene, const FrameJ
   // transfer functions that changed are computed again (FrameTables::lut_sources).
   build_frame_tables(scene, hierarchy_, layout_, channels_, fo, tables_);
   tables_.image_to_host = options_.output != FrameOutput::device;
-  visible_subtrees_.refresh(*octree_, options_.mode, tables_);
+  visible_subtrees_.refresh(*octree_, options_.mode, options_.skip_min_samples, tables_);
   return tables_;
 }
 

@@ -1,6 +1,7 @@
 #include "resoct/render/renderer_options.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <thread>
 
 #include "resoct/base/error.hpp"
@@ -59,6 +60,9 @@ void TuningOptions::validate() const {
   }
   if (max_node_answers == 0) throw invalid_parameter("max_node_answers", "must be > 0");
   if (max_iterations == 0) throw invalid_parameter("max_iterations", "must be > 0");
+  if (!std::isfinite(skip_min_samples) || skip_min_samples < 0.0f) {
+    throw invalid_parameter("skip_min_samples", "must be finite and >= 0");
+  }
 }
 
 void RendererOptions::validate() const {

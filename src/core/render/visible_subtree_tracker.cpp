@@ -24,7 +24,7 @@ void VisibleSubtreeTracker::note_sent(const OctreeDeltas& deltas, bool full,
 }
 
 void VisibleSubtreeTracker::refresh(const ResidencyOctree& octree, RenderMode mode,
-                                    FrameTables& tables) {
+                                    float skip_min_samples, FrameTables& tables) {
   if (mode != RenderMode::residency) {
     build_visible_subtrees(octree, tables);  // clears them
     changed_nodes_.clear();
@@ -35,12 +35,14 @@ void VisibleSubtreeTracker::refresh(const ResidencyOctree& octree, RenderMode mo
   key.depth_limit =
       deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots);
   key.start_depth = tables.frame.start_depth;
+  hidden_allowance(tables.frame, tables.depths, skip_min_samples, key.allowance);
+  brick_depths(tables.levels, tables.slots, key.brick_depth);
   key.entries.clear();
   for (const kernel::ResoctSlotInfo& s : tables.slots) {
     key.entries.insert(key.entries.end(), {s.slot, s.vis_bins, s.vis_lo16, s.vis_hi16});
   }
   if (rebuild_ || key != key_ || tables.visible_subtrees_version == 0) {
-    builder_.build(octree, tables, key.depth_limit);
+    builder_.build(octree, tables, key.depth_limit, key.allowance, key.brick_depth);
     std::swap(key_, scratch_);
     rebuild_ = false;
   } else if (!changed_nodes_.empty()) {

@@ -3,10 +3,12 @@
 // visible_subtrees, render/visible_subtrees.hpp) must be rebuilt, updated or left alone.
 //
 // The bits are computed from the octree's records and from what the frame's tables say about
-// them (the transfer functions' visible ranges, the start depth and the deepest depth a ray
-// descends to). A still scene whose cache has converged changes neither, so a steady frame does
-// no work here; node answers and brick metadata arriving while a view loads change some records,
-// and only the paths above those are computed again (VisibleSubtreeBuilder::update).
+// them (the transfer functions' visible ranges, the start depth, the deepest depth a ray
+// descends to, the hidden fraction each depth allows, which follows the shortest step, and the
+// depth of each entry's finest bricks). A still
+// scene whose cache has converged changes neither, so a steady frame does no work here; node
+// answers and brick metadata arriving while a view loads change some records, and only the paths
+// above those are computed again (VisibleSubtreeBuilder::update).
 #include <cstdint>
 #include <vector>
 
@@ -25,8 +27,10 @@ class VisibleSubtreeTracker {
   void note_sent(const OctreeDeltas& deltas, bool full, std::uint32_t node_slots);
 
   /// Brings tables.visible_subtrees up to date with `octree` (the words as sent) after the rest of
-  /// `tables` was built for this frame: residency mode only; other modes get none (version 0).
-  void refresh(const ResidencyOctree& octree, RenderMode mode, FrameTables& tables);
+  /// `tables` was built for this frame, with the allowance of `skip_min_samples`
+  /// (TuningOptions::skip_min_samples): residency mode only; other modes get none (version 0).
+  void refresh(const ResidencyOctree& octree, RenderMode mode, float skip_min_samples,
+               FrameTables& tables);
 
  private:
   // What the bits were built from besides the octree's words.
@@ -34,6 +38,8 @@ class VisibleSubtreeTracker {
     std::uint32_t depth_limit = 0;
     std::uint32_t start_depth = 0;
     std::vector<std::uint32_t> entries;  // per slot-table entry: slot, vis_bins, vis_lo16, vis_hi16
+    std::vector<std::uint16_t> allowance;    // per depth: hidden_allowance()
+    std::vector<std::uint32_t> brick_depth;  // per entry: brick_depths()
     bool operator==(const Key&) const = default;
   };
   Key key_;

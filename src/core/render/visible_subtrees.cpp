@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <string>
 
 #include "resoct/base/error.hpp"
@@ -46,23 +47,6 @@ std::uint32_t level_depth_cap(std::span<const k::ResoctDepthInfo> depths, std::u
   return depth;
 }
 
-// Whether the record of `slot` at `node` has metadata and a range `entry` shows; sets
-// `homogeneous` when the record is VALID with min = max (kernel/node_class.glsl.h
-// resoct_node_class).
-bool record_shown(std::span<const std::uint32_t> words, std::uint32_t node,
-                  const k::ResoctSlotInfo& entry, std::uint32_t node_slots, bool& homogeneous) {
-  const std::uint32_t base = k::resoct_node_base(node, entry.slot, node_slots);
-  const std::uint32_t state = k::resoct_node_state(words[base + k::RESOCT_NODE_FLAGS]);
-  if (state == k::RESOCT_NODE_INVALID) return false;
-  const std::uint32_t minmax = words[base + k::RESOCT_NODE_MINMAX];
-  if (!k::resoct_node_range_visible(minmax, entry.vis_lo16, entry.vis_hi16, entry.vis_bins)) {
-    return false;
-  }
-  homogeneous =
-      state == k::RESOCT_NODE_VALID && k::resoct_node_min16(minmax) == k::resoct_node_max16(minmax);
-  return true;
-}
-
 // The coordinate a local index holds in the bits `mask` (ResoctDepthInfo::axis_bits_*): the
 // mask's bits from the lowest up are the coordinate's from its least significant bit.
 std::uint32_t extract_bits(std::uint32_t local, std::uint32_t mask) {
@@ -90,13 +74,7 @@ std::uint64_t next_visible_subtrees_version() {
 
 }  // namespace
 
-std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
-                                      std::span<const k::ResoctLevelInfo> levels,
-                                      std::span<const k::ResoctDepthInfo> depths,
-                                      std::span<const k::ResoctSlotInfo> slots) {
-  if (depths.empty()) return 0;
-  const std::uint32_t start =
-      std::min<std::uint32_t>(f.start_depth, std::uint32_t(depths.size()) - 1);
+float shortest_step(const k::ResoctFrame& f) {
   // The kernel's step (kernel/step.glsl.h resoct_step_size) is min_i h_i / |d_i| over the axes,
   // which for a unit direction is at least min_i h_i: an axis-aligned ray has the shortest. Its
   // step level rounds it down as the kernel does (kernel/step_lut.glsl.h), a monotone rounding.
@@ -110,7 +88,17 @@ std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
       dt = std::bit_cast<float>((f.step_level_first + level) << f.step_level_shift) * f.ref_step;
     }
   }
-  std::uint32_t depth = traversal_depth(depths, start, f, dt);
+  return dt;
+}
+
+std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
+                                      std::span<const k::ResoctLevelInfo> levels,
+                                      std::span<const k::ResoctDepthInfo> depths,
+                                      std::span<const k::ResoctSlotInfo> slots) {
+  if (depths.empty()) return 0;
+  const std::uint32_t start =
+      std::min<std::uint32_t>(f.start_depth, std::uint32_t(depths.size()) - 1);
+  std::uint32_t depth = traversal_depth(depths, start, f, shortest_step(f));
   // The finest level any entry samples gives the deepest level cap.
   std::uint32_t finest = 0xFFFFFFFFu;
   for (const k::ResoctSlotInfo& s : slots) {
@@ -121,57 +109,126 @@ std::uint32_t deepest_traversal_depth(const k::ResoctFrame& f,
   return depth;
 }
 
+void hidden_allowance(const k::ResoctFrame& f, std::span<const k::ResoctDepthInfo> depths,
+                      float skip_min_samples, std::vector<std::uint16_t>& out) {
+  out.assign(depths.size(), 0u);
+  if (!(skip_min_samples > 0.0f)) return;
+  const float dt = shortest_step(f);
+  for (std::size_t d = 0; d < depths.size(); ++d) {
+    const k::ResoctDepthInfo& D = depths[d];
+    const float side = std::min(float(D.node_extent_x) / f.voxels_per_box_x,
+                                std::min(float(D.node_extent_y) / f.voxels_per_box_y,
+                                         float(D.node_extent_z) / f.voxels_per_box_z));
+    const float samples = side / dt;
+    // A node a ray crosses in fewer samples than skip_min_samples saves fewer however much of it
+    // is hidden: the whole fraction (an EMPTY node itself still gets no bit).
+    const float share = samples > skip_min_samples ? skip_min_samples / samples : 1.0f;
+    out[d] = std::uint16_t(
+        std::clamp(std::floor(share * float(kHiddenWhole)), 0.0f, float(kHiddenWhole)));
+  }
+}
+
+void brick_depths(std::span<const k::ResoctLevelInfo> levels,
+                  std::span<const k::ResoctSlotInfo> slots, std::vector<std::uint32_t>& out) {
+  // Without a depth that holds the level's bricks (RESOCT_NONE_U), every hidden node blocks.
+  out.assign(slots.size(), 0xFFFFFFFFu);
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const std::uint32_t finest = slots[i].finest_level;
+    if (finest < levels.size() && levels[finest].node_depth != 0xFFFFFFFFu) {
+      out[i] = levels[finest].node_depth;
+    }
+  }
+}
+
 void build_visible_subtrees(std::span<const std::uint32_t> words, std::uint32_t node_slots,
                             std::span<const k::ResoctDepthInfo> depths,
                             std::span<const k::ResoctSlotInfo> slots, glm::uvec3 extent,
                             std::uint32_t start_depth, std::uint32_t depth_limit,
-                            std::vector<std::uint32_t>& out) {
+                            std::vector<std::uint32_t>& out,
+                            std::span<const std::uint16_t> allowance,
+                            std::span<const std::uint32_t> brick_depth) {
   VisibleSubtreeBuilder().build(words, node_slots, depths, slots, extent, start_depth, depth_limit,
-                                out);
+                                out, allowance, brick_depth);
 }
 
-void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables) {
+void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables,
+                            float skip_min_samples) {
   if (tables.frame.mode != k::RESOCT_MODE_RESIDENCY) {
     tables.visible_subtrees.clear();
     tables.visible_subtrees_version = 0;
     return;
   }
+  std::vector<std::uint16_t> allowance;
+  hidden_allowance(tables.frame, tables.depths, skip_min_samples, allowance);
+  std::vector<std::uint32_t> bricks;
+  brick_depths(tables.levels, tables.slots, bricks);
   VisibleSubtreeBuilder().build(
       octree, tables,
-      deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots));
+      deepest_traversal_depth(tables.frame, tables.levels, tables.depths, tables.slots), allowance,
+      bricks);
 }
 
-// A node's mask and word from its record and its children's masks (the children's first, when
-// the node is above the depth limit). The limit's own nodes are checked but their children are
-// not: no ray descends past them, and they get no word.
+// A node's mask, word and hidden fractions from its record and its children's (the children's
+// first, when the node is above the depth limit). The limit's own nodes are checked but their
+// children are not: no ray descends past them, and they get no word.
 VisibleSubtreeBuilder::NodeResult VisibleSubtreeBuilder::compute(
-    std::span<const std::uint32_t> words, std::uint32_t depth, std::uint32_t local) const {
+    std::span<const std::uint32_t> words, std::uint32_t depth, std::uint32_t local,
+    std::uint16_t* hidden) const {
+  const std::uint32_t entries = std::uint32_t(slots_.size());
+  std::fill(hidden, hidden + entries, std::uint16_t(0));
   const k::ResoctDepthInfo& D = depths_[depth];
-  if (some_outside_[depth] != 0u && outside_volume(D, local, extent_)) return {shown_, 0u};
-  std::uint32_t ok = shown_;
-  if (depth < depth_limit_) {
+  if (some_outside_[depth] != 0u && outside_volume(D, local, extent_)) return {shown_, 0u, 0u};
+  const bool inner = depth < depth_limit_;
+  std::uint32_t children_known = shown_, children_blocked = 0;
+  std::uint32_t first = 0, children = 0;
+  if (inner) {
     const k::ResoctDepthInfo& below = depths_[depth + 1];
-    const std::uint32_t first = below.first_node + (local << below.child_shift);
-    for (std::uint32_t c = 0; c < (1u << below.child_shift); ++c) ok &= ok_[first + c];
-  }
-  std::uint32_t bits = 0;
-  for (std::uint32_t pending = ok; pending != 0u; pending &= pending - 1u) {
-    const std::uint32_t i = std::uint32_t(std::countr_zero(pending));
-    bool homogeneous = false;
-    if (!record_shown(words, D.first_node + local, slots_[i], node_slots_, homogeneous)) {
-      ok &= ~(1u << i);
-    } else if (!homogeneous) {
-      bits |= 1u << i;
+    first = below.first_node + (local << below.child_shift);
+    children = 1u << below.child_shift;
+    for (std::uint32_t c = 0; c < children; ++c) {
+      children_known &= known_[first + c];
+      children_blocked |= blocked_[first + c];
     }
   }
-  return {ok, depth < depth_limit_ ? bits : 0u};
+  std::uint32_t known = 0, blocked = 0, bits = 0;
+  for (std::uint32_t pending = shown_; pending != 0u; pending &= pending - 1u) {
+    const std::uint32_t i = std::uint32_t(std::countr_zero(pending));
+    const std::uint32_t bit = 1u << i;
+    const std::uint32_t base =
+        k::resoct_node_base(D.first_node + local, slots_[i].slot, node_slots_);
+    const std::uint32_t state = k::resoct_node_state(words[base + k::RESOCT_NODE_FLAGS]);
+    if (state == k::RESOCT_NODE_INVALID) continue;  // unknown: no bit here or above
+    const std::uint32_t minmax = words[base + k::RESOCT_NODE_MINMAX];
+    if (!k::resoct_node_range_visible(minmax, slots_[i].vis_lo16, slots_[i].vis_hi16,
+                                      slots_[i].vis_bins)) {
+      // Hidden: wholly, and what lies below it is never read (the descent skips it; below a
+      // set bit it is sampled, transparent). Whole bricks hidden are never widened over.
+      known |= bit;
+      hidden[i] = std::uint16_t(kHiddenWhole);
+      if (!brick_depth_.empty() && depth <= brick_depth_[i]) blocked |= bit;
+      continue;
+    }
+    if ((children_known & bit) == 0u) continue;
+    known |= bit;
+    blocked |= children_blocked & bit;
+    if (!inner) continue;
+    std::uint32_t sum = 0;
+    for (std::uint32_t c = 0; c < children; ++c) sum += hidden_[(first + c) * entries + i];
+    hidden[i] = std::uint16_t((sum + children - 1u) / children);  // rounded up: 0 only if none
+    const bool homogeneous = state == k::RESOCT_NODE_VALID &&
+                             k::resoct_node_min16(minmax) == k::resoct_node_max16(minmax);
+    if (!homogeneous && (blocked & bit) == 0u && hidden[i] <= allowance_[depth]) bits |= bit;
+  }
+  return {known, blocked, bits};
 }
 
 void VisibleSubtreeBuilder::build(std::span<const std::uint32_t> words, std::uint32_t node_slots,
                                   std::span<const k::ResoctDepthInfo> depths,
                                   std::span<const k::ResoctSlotInfo> slots, glm::uvec3 extent,
                                   std::uint32_t start_depth, std::uint32_t depth_limit,
-                                  std::vector<std::uint32_t>& out) {
+                                  std::vector<std::uint32_t>& out,
+                                  std::span<const std::uint16_t> allowance,
+                                  std::span<const std::uint32_t> brick_depth) {
   nodes_ = 0;
   out.clear();
   if (depths.empty()) return;
@@ -192,6 +249,23 @@ void VisibleSubtreeBuilder::build(std::span<const std::uint32_t> words, std::uin
     }
     if (slots[i].vis_bins != 0u) shown_ |= 1u << i;
   }
+  if (!allowance.empty() && allowance.size() != depths.size()) {
+    throw invalid_parameter("allowance", std::to_string(allowance.size()) + " values for " +
+                                             std::to_string(depths.size()) + " depths");
+  }
+  if (!brick_depth.empty() && brick_depth.size() != slots.size()) {
+    throw invalid_parameter("brick_depth", std::to_string(brick_depth.size()) + " values for " +
+                                               std::to_string(slots.size()) + " entries");
+  }
+  brick_depth_.clear();
+  if (!brick_depth.empty()) {
+    brick_depth_.assign(brick_depth.begin(), brick_depth.begin() + std::ptrdiff_t(entries));
+  }
+  if (allowance.empty()) {
+    allowance_.assign(depths.size(), 0u);
+  } else {
+    allowance_.assign(allowance.begin(), allowance.end());
+  }
   node_slots_ = node_slots;
   depths_.assign(depths.begin(), depths.end());
   slots_.assign(slots.begin(), slots.begin() + entries);
@@ -206,7 +280,9 @@ void VisibleSubtreeBuilder::build(std::span<const std::uint32_t> words, std::uin
                        std::uint64_t(D.count_y - 1u) * D.node_extent_y >= extent.y ||
                        std::uint64_t(D.count_z - 1u) * D.node_extent_z >= extent.z;
   }
-  ok_.assign(std::size_t(nodes), 0u);
+  known_.assign(std::size_t(nodes), 0u);
+  blocked_.assign(std::size_t(nodes), 0u);
+  hidden_.assign(std::size_t(nodes) * entries, 0u);
   out.assign(std::size_t(nodes), 0u);
   nodes_ = nodes;
   if (shown_ == 0u || depth_limit_ <= start_depth_) return;
@@ -215,9 +291,11 @@ void VisibleSubtreeBuilder::build(std::span<const std::uint32_t> words, std::uin
     const k::ResoctDepthInfo& D = depths_[d];
     const std::uint32_t count = D.count_x * D.count_y * D.count_z;
     for (std::uint32_t local = 0; local < count; ++local) {
-      const NodeResult r = compute(words, d, local);
-      ok_[D.first_node + local] = r.ok;
-      out[D.first_node + local] = r.bits;
+      const std::uint32_t node = D.first_node + local;
+      const NodeResult r = compute(words, d, local, hidden_.data() + std::size_t(node) * entries);
+      known_[node] = r.known;
+      blocked_[node] = r.blocked;
+      out[node] = r.bits;
     }
   }
 }
@@ -245,21 +323,28 @@ VisibleSubtreeUpdate VisibleSubtreeBuilder::update(std::span<const std::uint32_t
     if (d >= start_depth_ && d <= depth_limit_) pending_[d].push_back(node - depths_[d].first_node);
   }
   // Deepest first: a node is recomputed after its changed children, and its parent is queued
-  // only when its mask changed (a word alone changing stops there).
+  // only when its mask or a hidden fraction changed (a word alone changing stops there).
+  const std::size_t entries = slots_.size();
+  std::uint16_t hidden[k::RESOCT_MAX_SLOTS];
   for (std::uint32_t d = depth_limit_ + 1; d-- > start_depth_;) {
     std::vector<std::uint32_t>& locals = pending_[d];
     std::sort(locals.begin(), locals.end());
     locals.erase(std::unique(locals.begin(), locals.end()), locals.end());
     const k::ResoctDepthInfo& D = depths_[d];
     for (const std::uint32_t local : locals) {
-      const NodeResult r = compute(words, d, local);
+      const std::uint32_t node = D.first_node + local;
+      const NodeResult r = compute(words, d, local, hidden);
       ++result.recomputed;
-      if (out[D.first_node + local] != r.bits) {
-        out[D.first_node + local] = r.bits;
+      if (out[node] != r.bits) {
+        out[node] = r.bits;
         ++result.words_changed;
       }
-      if (r.ok != ok_[D.first_node + local]) {
-        ok_[D.first_node + local] = r.ok;
+      std::uint16_t* kept = hidden_.data() + std::size_t(node) * entries;
+      if (r.known != known_[node] || r.blocked != blocked_[node] ||
+          !std::equal(hidden, hidden + entries, kept)) {
+        known_[node] = r.known;
+        blocked_[node] = r.blocked;
+        std::copy(hidden, hidden + entries, kept);
         if (d > start_depth_) pending_[d - 1].push_back(local >> D.child_shift);
       }
     }
@@ -268,10 +353,12 @@ VisibleSubtreeUpdate VisibleSubtreeBuilder::update(std::span<const std::uint32_t
 }
 
 void VisibleSubtreeBuilder::build(const ResidencyOctree& octree, FrameTables& tables,
-                                  std::uint32_t depth_limit) {
+                                  std::uint32_t depth_limit,
+                                  std::span<const std::uint16_t> allowance,
+                                  std::span<const std::uint32_t> brick_depth) {
   build(octree.words(), tables.frame.node_slot_count, tables.depths, tables.slots,
         glm::uvec3(tables.frame.extent_x, tables.frame.extent_y, tables.frame.extent_z),
-        tables.frame.start_depth, depth_limit, tables.visible_subtrees);
+        tables.frame.start_depth, depth_limit, tables.visible_subtrees, allowance, brick_depth);
   tables.visible_subtrees_version = next_visible_subtrees_version();
 }
 

@@ -1,6 +1,8 @@
 // The frame's visible-subtree bits (render/visible_subtrees.hpp) on a hand-made octree of three
 // depths (1, 8 and 64 nodes; one record slot), against what the residency descent would find:
-// a bit only where no node at or below it, down to the depth limit, is hidden or unknown.
+// a bit only where no node at or below it, down to the depth limit, is unknown, and none is
+// hidden or (with an allowance, TuningOptions::skip_min_samples) too little is for a descent to
+// pay.
 #include <cstdint>
 #include <random>
 #include <string>
@@ -65,10 +67,10 @@ struct Tree {
         k::resoct_node_pack_minmax(std::uint32_t(lo * 65535.0), std::uint32_t(hi * 65535.0));
   }
   std::vector<std::uint32_t> bits(std::vector<k::ResoctSlotInfo> slots, std::uint32_t start = 0,
-                                  std::uint32_t limit = 2,
-                                  glm::uvec3 extent = glm::uvec3(32u)) const {
+                                  std::uint32_t limit = 2, glm::uvec3 extent = glm::uvec3(32u),
+                                  std::vector<std::uint16_t> allowance = {}) const {
     std::vector<std::uint32_t> out;
-    build_visible_subtrees(words, 1, depths(), slots, extent, start, limit, out);
+    build_visible_subtrees(words, 1, depths(), slots, extent, start, limit, out, allowance);
     return out;
   }
 };
@@ -156,6 +158,109 @@ TEST(VisibleSubtreesLimits, ShortOctreesAndForeignSlotsAreRejected) {
                Error);
 }
 
+// A frame whose shortest step is one voxel of a 32³ volume in a unit box: the root is 32 samples
+// across, its children 16, the leaves 8.
+k::ResoctFrame voxel_step_frame() {
+  k::ResoctFrame f{};
+  f.voxels_per_box_x = f.voxels_per_box_y = f.voxels_per_box_z = 32.0f;
+  f.finest_voxel_x = f.finest_voxel_y = f.finest_voxel_z = 1.0f / 32.0f;
+  f.step_scale = 1.0f;
+  f.ref_step = 1.0f / 32.0f;
+  return f;
+}
+
+// What a depth allows hidden: skip_min_samples over the samples a ray takes across its nodes.
+TEST(VisibleSubtreesAllowance, IsTheShareOfANodeWhoseSamplesWouldSaveTooFewToDescend) {
+  std::vector<std::uint16_t> allowance;
+  hidden_allowance(voxel_step_frame(), depths(), 8.0f, allowance);
+  ASSERT_EQ(allowance.size(), 3u);
+  EXPECT_EQ(allowance[0], 16383u) << "8 of 32 samples: a quarter, rounded down";
+  EXPECT_EQ(allowance[1], 32767u) << "8 of 16";
+  EXPECT_EQ(allowance[2], kHiddenWhole) << "a leaf is crossed in 8 samples: nothing it hides pays";
+  hidden_allowance(voxel_step_frame(), depths(), 0.0f, allowance);
+  EXPECT_EQ(allowance, std::vector<std::uint16_t>(3, 0u)) << "0: only subtrees hiding nothing";
+  k::ResoctFrame coarse = voxel_step_frame();
+  coarse.step_scale = 2.0f;  // half as many samples: twice the share
+  hidden_allowance(coarse, depths(), 4.0f, allowance);
+  EXPECT_EQ(allowance[0], 16383u);
+}
+
+// One hidden leaf of 64: its parent hides an eighth (8192 of 65535, rounded up), the root a
+// sixty-fourth (1024). Each gets its bit when its depth allows that much.
+TEST(VisibleSubtreesAllowance, ANodeHidingNoMoreThanItsDepthAllowsKeepsItsBit) {
+  Tree t;
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.05);
+  const auto strict = t.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), {0, 0, 0});
+  EXPECT_EQ(strict[0], 0u);
+  EXPECT_EQ(strict[kLeafParent], 0u);
+  const auto root_only = t.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), {1024, 8191, 0});
+  EXPECT_EQ(root_only[0], 1u) << "1024 hidden, 1024 allowed";
+  EXPECT_EQ(root_only[kLeafParent], 0u) << "8192 hidden, 8191 allowed";
+  const auto none = t.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), {1023, 8191, 0});
+  EXPECT_EQ(none[0], 0u) << "1024 hidden, 1023 allowed";
+  const auto both = t.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), {1024, 8192, 0});
+  EXPECT_EQ(both[0], 1u);
+  EXPECT_EQ(both[kLeafParent], 1u);
+  for (std::uint32_t n = 1; n < 9; ++n) {
+    if (n != kLeafParent) EXPECT_EQ(both[n], 1u) << "node " << n << " hides nothing";
+  }
+}
+
+// The allowance widens what a bit may hide, never what it must know: an INVALID record below
+// still clears it (the descent would request it), an EMPTY or homogeneous node never gets one,
+// and nodes inside an EMPTY node are not read (no ray's descent reaches them).
+TEST(VisibleSubtreesAllowance, UnknownRecordsStillClearTheBitAndHiddenNodesGetNone) {
+  const std::vector<std::uint16_t> all(3, std::uint16_t(kHiddenWhole));
+  Tree unknown;
+  unknown.set(kLeaf, k::RESOCT_NODE_INVALID, 0.0, 0.0);
+  const auto u = unknown.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), all);
+  EXPECT_EQ(u[0], 0u);
+  EXPECT_EQ(u[kLeafParent], 0u);
+  Tree hidden;
+  hidden.set(kLeafParent, k::RESOCT_NODE_VALID, 0.0, 0.05);
+  hidden.set(kLeaf, k::RESOCT_NODE_INVALID, 0.0, 0.0);  // below an EMPTY node: never requested
+  const auto h = hidden.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), all);
+  EXPECT_EQ(h[0], 1u) << "an eighth hidden, all of it allowed; the unknown leaf is not read";
+  EXPECT_EQ(h[kLeafParent], 0u) << "an EMPTY node is skipped, not marched";
+  EXPECT_EQ(hidden.bits({shows_from(0.1)})[0], 0u) << "without an allowance";
+  Tree homogeneous;
+  homogeneous.set(kLeafParent, k::RESOCT_NODE_VALID, 0.5, 0.5);
+  EXPECT_EQ(homogeneous.bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), all)[kLeafParent], 0u);
+  EXPECT_THROW(Tree().bits({shows_from(0.1)}, 0, 2, glm::uvec3(32u), {0, 0}), Error)
+      << "one value per depth";
+}
+
+// A hidden node that holds whole bricks of the finest level sampled (at or above the entry's
+// brick depth) is never widened over: sampling it would request bricks no descent reads.
+TEST(VisibleSubtreesAllowance, HiddenNodesOfWholeBricksKeepTheirAncestorsBitsCleared) {
+  const std::vector<std::uint16_t> all(3, std::uint16_t(kHiddenWhole));
+  Tree t;
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.05);
+  std::vector<std::uint32_t> out;
+  const std::vector<std::uint32_t> leaves_are_bricks{2}, parents_are_bricks{1};
+  build_visible_subtrees(t.words, 1, depths(), std::vector{shows_from(0.1)}, glm::uvec3(32u), 0, 2,
+                         out, all, leaves_are_bricks);
+  EXPECT_EQ(out[0], 0u) << "the hidden leaf is a whole brick";
+  EXPECT_EQ(out[kLeafParent], 0u);
+  build_visible_subtrees(t.words, 1, depths(), std::vector{shows_from(0.1)}, glm::uvec3(32u), 0, 2,
+                         out, all, parents_are_bricks);
+  EXPECT_EQ(out[0], 1u) << "the hidden leaf is an eighth of a brick its neighbours show";
+  EXPECT_EQ(out[kLeafParent], 1u);
+  EXPECT_THROW(
+      build_visible_subtrees(t.words, 1, depths(), std::vector{shows_from(0.1)}, glm::uvec3(32u), 0,
+                             2, out, all, std::vector<std::uint32_t>{1, 1}),
+      Error)
+      << "one brick depth per entry";
+  std::vector<k::ResoctLevelInfo> levels(2);
+  levels[0].node_depth = 2;
+  levels[1].node_depth = 0xFFFFFFFFu;  // no depth holds these bricks
+  k::ResoctSlotInfo fine = shows_from(0.1), coarse = shows_from(0.1);
+  coarse.finest_level = 1;
+  std::vector<std::uint32_t> depth;
+  brick_depths(levels, std::vector{fine, coarse}, depth);
+  EXPECT_EQ(depth, (std::vector<std::uint32_t>{2u, 0xFFFFFFFFu}));
+}
+
 // The depth limit is the deepest traversal depth of any ray: an axis-aligned ray's step, and the
 // finest level any shown entry samples.
 TEST(VisibleSubtreesLimits, TheDepthLimitFollowsTheShortestStepAndTheFinestLevel) {
@@ -190,42 +295,48 @@ TEST(VisibleSubtreeUpdates, GiveWhatAFullBuildOfTheChangedRecordsGives) {
   const glm::uvec3 extent(32, 24, 32);
   std::mt19937 rng(20261128);
   auto draw = [&rng](std::uint32_t n) { return std::uint32_t(rng() % n); };
-  for (std::uint32_t start = 0; start < 2; ++start) {
-    for (std::uint32_t limit = start + 1; limit < 3; ++limit) {
-      std::vector<std::uint32_t> words(kNodes * kSlots * k::RESOCT_NODE_WORDS, 0u);
-      auto set_random = [&](std::uint32_t node) {
-        for (std::uint32_t s = 0; s < kSlots; ++s) {
-          const std::uint32_t base = k::resoct_node_base(node, s, kSlots);
-          // Mostly shown ranges, so that bits exist for changes to clear; some hidden, unknown
-          // and homogeneous ones.
-          const std::uint32_t kind = draw(24);
-          const std::uint32_t lo = kind == 0   ? draw(6000)
-                                   : kind == 1 ? 30000u
-                                               : 20000u + draw(20000);
-          const std::uint32_t hi = kind == 0 ? lo + draw(100) : kind == 1 ? lo : lo + draw(20000);
-          words[base + k::RESOCT_NODE_FLAGS] = k::resoct_node_make_flags(
-              kind == 2 ? k::RESOCT_NODE_INVALID : k::RESOCT_NODE_VALID, 0u);
-          words[base + k::RESOCT_NODE_MINMAX] = k::resoct_node_pack_minmax(lo, hi);
+  const std::vector<std::vector<std::uint16_t>> allowances = {{}, {3000, 20000, 65535}};
+  for (const std::vector<std::uint16_t>& allowance : allowances) {
+    for (std::uint32_t start = 0; start < 2; ++start) {
+      for (std::uint32_t limit = start + 1; limit < 3; ++limit) {
+        std::vector<std::uint32_t> words(kNodes * kSlots * k::RESOCT_NODE_WORDS, 0u);
+        auto set_random = [&](std::uint32_t node) {
+          for (std::uint32_t s = 0; s < kSlots; ++s) {
+            const std::uint32_t base = k::resoct_node_base(node, s, kSlots);
+            // Mostly shown ranges, so that bits exist for changes to clear; some hidden, unknown
+            // and homogeneous ones.
+            const std::uint32_t kind = draw(24);
+            const std::uint32_t lo = kind == 0   ? draw(6000)
+                                     : kind == 1 ? 30000u
+                                                 : 20000u + draw(20000);
+            const std::uint32_t hi = kind == 0 ? lo + draw(100) : kind == 1 ? lo : lo + draw(20000);
+            words[base + k::RESOCT_NODE_FLAGS] = k::resoct_node_make_flags(
+                kind == 2 ? k::RESOCT_NODE_INVALID : k::RESOCT_NODE_VALID, 0u);
+            words[base + k::RESOCT_NODE_MINMAX] = k::resoct_node_pack_minmax(lo, hi);
+          }
+        };
+        for (std::uint32_t n = 0; n < kNodes; ++n) set_random(n);
+        VisibleSubtreeBuilder builder;
+        std::vector<std::uint32_t> kept;
+        builder.build(words, kSlots, depths(), entries, extent, start, limit, kept, allowance);
+        std::uint64_t changed_words = 0;
+        for (int round = 0; round < 300; ++round) {
+          std::vector<std::uint32_t> changed(1 + draw(4));
+          for (std::uint32_t& n : changed) {
+            n = draw(kNodes);
+            set_random(n);
+          }
+          changed.push_back(changed.front());  // repeats are allowed
+          changed_words += builder.update(words, changed, kept).words_changed;
+          std::vector<std::uint32_t> fresh;
+          build_visible_subtrees(words, kSlots, depths(), entries, extent, start, limit, fresh,
+                                 allowance);
+          ASSERT_EQ(kept, fresh) << "start " << start << ", limit " << limit << ", round " << round
+                                 << ", allowance " << allowance.size();
         }
-      };
-      for (std::uint32_t n = 0; n < kNodes; ++n) set_random(n);
-      VisibleSubtreeBuilder builder;
-      std::vector<std::uint32_t> kept;
-      builder.build(words, kSlots, depths(), entries, extent, start, limit, kept);
-      std::uint64_t changed_words = 0;
-      for (int round = 0; round < 300; ++round) {
-        std::vector<std::uint32_t> changed(1 + draw(4));
-        for (std::uint32_t& n : changed) {
-          n = draw(kNodes);
-          set_random(n);
-        }
-        changed.push_back(changed.front());  // repeats are allowed
-        changed_words += builder.update(words, changed, kept).words_changed;
-        std::vector<std::uint32_t> fresh;
-        build_visible_subtrees(words, kSlots, depths(), entries, extent, start, limit, fresh);
-        ASSERT_EQ(kept, fresh) << "start " << start << ", limit " << limit << ", round " << round;
+        EXPECT_GE(changed_words, 10u)
+            << "the rounds must change bits for the check to mean anything";
       }
-      EXPECT_GE(changed_words, 10u) << "the rounds must change bits for the check to mean anything";
     }
   }
 }
