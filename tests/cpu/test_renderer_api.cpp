@@ -93,8 +93,8 @@ TEST(RendererApi, NullBackendIsRejectedNamingIt) {
 }
 
 TEST(RendererApi, ASkipThresholdThatIsNoCountOfSamplesIsRejectedNamingIt) {
-  for (float k : {-1.0f, std::numeric_limits<float>::quiet_NaN(),
-                  std::numeric_limits<float>::infinity()}) {
+  for (float k :
+       {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
     RendererOptions o = sync_viewer();
     o.skip_min_samples = k;
     EXPECT_RESOCT_ERROR(Renderer(tubes(), cpu::make_backend(1), o), ErrorCode::invalid_argument,
