@@ -63,6 +63,7 @@ struct Args {
   std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
   std::string strategy = "greedy";
   std::uint32_t leaf = 16;
+  float skip_min_samples = resoct::kDefaultSkipMinSamples;
   std::optional<double> lod_error_color;  // overrides the scene's (error-bounded LOD)
   std::uint32_t retry_failed_ms = 0;
   std::optional<std::uint32_t> timepoint;  // overrides the scene's
@@ -278,6 +279,10 @@ int run(const Args& a) {
   o.retry_failed_after_ms = a.retry_failed_ms;
   if (a.leaf == 0) throw invalid_parameter("leaf", "must be > 0");
   o.leaf_size = glm::uvec3(a.leaf);
+  if (!std::isfinite(a.skip_min_samples) || a.skip_min_samples < 0.0f) {
+    throw invalid_parameter("skip-min-samples", "must be finite and >= 0");
+  }
+  o.skip_min_samples = a.skip_min_samples;
   if (a.accumulate > 4096) throw invalid_parameter("accumulate", "must be 0..4096");
   if (a.accumulate > 1 && !a.converge) {
     throw invalid_parameter("accumulate", "needs --converge (it averages the converged view)");
@@ -512,6 +517,11 @@ int main(int argc, char** argv) {
                  "(doubling up to 32x; 0 = never)")
       ->capture_default_str();
   app.add_option("--leaf", a.leaf, "residency octree leaf size (voxels per axis)")
+      ->capture_default_str();
+  app.add_option("--skip-min-samples", a.skip_min_samples,
+                 "residency mode: descend below a node only where what it hides saves a ray more "
+                 "than this many samples (0 = wherever anything is hidden; docs/rendering.md "
+                 "\"Visible subtrees\")")
       ->capture_default_str();
   app.add_option("--lod-error-color", a.lod_error_color,
                  "error-bounded LOD: sample the coarsest level whose measured error moves a "

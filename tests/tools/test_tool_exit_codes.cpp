@@ -259,6 +259,8 @@ TEST_F(ToolExitCodes, RenderBadInputIs1AndLeavesTheOldOutputs) {
               "@DIR@/evil.nhdr: NRRD field 'data file' '/etc/passwd'", out);
   expect_exit(t, "resoct-render", render(ok, " --mode fastest"), kBadInput, "mode", out);
   expect_exit(t, "resoct-render", render(ok, " --cache-mb 0"), kBadInput, "cache-mb", out);
+  expect_exit(t, "resoct-render", render(ok, " --skip-min-samples -1"), kBadInput,
+              "skip-min-samples", out);
   expect_exit(t, "resoct-render",
               "--volume " + ok + " --scene @DIR@/missing.json --frames 1 --out @DIR@/out.png",
               kBadInput, "@DIR@/missing.json", out);

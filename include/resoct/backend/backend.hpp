@@ -111,10 +111,11 @@ struct FrameTables {
   /// Transfer-function LUTs the last build computed; the other slots' LUTs were kept.
   std::uint32_t luts_built = 0;
   /// Residency mode: one word per octree node whose bit i says that slot-table entry i finds no
-  /// node at or below it that its transfer function hides or whose metadata is missing
-  /// (render/visible_subtrees.hpp); the traversal then marches the node's box as one visible
-  /// node. Empty: no node has bits (what a backend must read as all zero). Built by the Renderer
-  /// from the octree it sends, not by build_frame_tables; otherwise empty.
+  /// node at or below it whose metadata is missing, and too little that its transfer function
+  /// hides for a descent to pay (render/visible_subtrees.hpp); the traversal then marches the
+  /// node's box as one visible node (hidden nodes inside it sampled, transparent). Empty: no node
+  /// has bits (what a backend must read as all zero). Built by the Renderer from the octree it
+  /// sends, not by build_frame_tables; otherwise empty.
   std::vector<std::uint32_t> visible_subtrees;
   /// Changes (process-wide counter) whenever visible_subtrees does; equal versions mean equal
   /// contents, 0 means "not versioned" (always send).

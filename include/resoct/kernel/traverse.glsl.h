@@ -19,8 +19,9 @@
 //   vec4  resoct_read_tf(uint slot, uint index)      (tf.glsl.h)
 //   vec4  resoct_read_preint(uint slot, uint index)  (preintegration.glsl.h)
 //   vec4  resoct_read_step_lut(uint index)           (step_lut.glsl.h)
-//   uint  resoct_read_visible_subtrees(uint node)    bit i: slot-table entry i finds no hidden or
-//                                                    unknown node at or below `node`
+//   uint  resoct_read_visible_subtrees(uint node)    bit i: slot-table entry i finds no unknown
+//                                                    node at or below `node`, and too little
+//                                                    hidden there to descend for
 //                                                    (render/visible_subtrees.hpp); 0 if none
 //   float resoct_read_level_size_log2(uint level)    (step.glsl.h)
 //   ResoctFxFrame resoct_read_fx_frame()               effect constants (effects.glsl.h)
