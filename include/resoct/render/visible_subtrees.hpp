@@ -72,8 +72,8 @@ void brick_depths(std::span<const kernel::ResoctLevelInfo> levels,
 /// - a hidden fraction (kHiddenWhole) of at most `allowance` at its depth (empty: 0, nothing
 ///   below hidden; hidden_allowance()), and no hidden node below at a depth at or above the
 ///   entry's `brick_depth` (brick_depths(); empty: none such). A hidden node below a set bit is
-///   sampled instead of skipped, and its samples are transparent; it lies inside bricks that its
-///   shown neighbours make rays read anyway.
+///   sampled instead of skipped, and its samples are transparent; being smaller than a brick, it
+///   lies inside one whose record is not hidden.
 /// Nodes wholly outside the volume [0, `extent`) (level-0 voxels), which no ray reaches, count as
 /// shown. Nodes at depths below `start_depth` or at and below `depth_limit` get 0. `words` are
 /// ResidencyOctree::words() with `node_slots` records per node (kernel/octree_node.glsl.h).

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
-#include <cmath>
 #include <string>
 
 #include "resoct/base/error.hpp"
@@ -15,17 +14,20 @@ namespace {
 
 namespace k = kernel;
 
+// The shortest side of a depth's nodes, in the frame's box units.
+float shortest_side(const k::ResoctDepthInfo& D, const k::ResoctFrame& f) {
+  return std::min(float(D.node_extent_x) / f.voxels_per_box_x,
+                  std::min(float(D.node_extent_y) / f.voxels_per_box_y,
+                           float(D.node_extent_z) / f.voxels_per_box_z));
+}
+
 // Deepest depth (at least start) whose nodes are at least `dt` long on every axis: the kernel's
 // resoct_traversal_depth_for over the host's depth table.
 std::uint32_t traversal_depth(std::span<const k::ResoctDepthInfo> depths, std::uint32_t start,
                               const k::ResoctFrame& f, float dt) {
   std::uint32_t depth = start;
   for (std::uint32_t d = start + 1; d < depths.size(); ++d) {
-    const k::ResoctDepthInfo& D = depths[d];
-    const float sx = float(D.node_extent_x) / f.voxels_per_box_x;
-    const float sy = float(D.node_extent_y) / f.voxels_per_box_y;
-    const float sz = float(D.node_extent_z) / f.voxels_per_box_z;
-    if (std::min(sx, std::min(sy, sz)) < dt) break;
+    if (shortest_side(depths[d], f) < dt) break;
     depth = d;
   }
   return depth;
@@ -115,26 +117,24 @@ void hidden_allowance(const k::ResoctFrame& f, std::span<const k::ResoctDepthInf
   if (!(skip_min_samples > 0.0f)) return;
   const float dt = shortest_step(f);
   for (std::size_t d = 0; d < depths.size(); ++d) {
-    const k::ResoctDepthInfo& D = depths[d];
-    const float side = std::min(float(D.node_extent_x) / f.voxels_per_box_x,
-                                std::min(float(D.node_extent_y) / f.voxels_per_box_y,
-                                         float(D.node_extent_z) / f.voxels_per_box_z));
-    const float samples = side / dt;
+    const float samples = shortest_side(depths[d], f) / dt;
     // A node a ray crosses in fewer samples than skip_min_samples saves fewer however much of it
-    // is hidden: the whole fraction (an EMPTY node itself still gets no bit).
+    // is hidden: the whole fraction (an EMPTY node itself still gets no bit). share is in (0, 1],
+    // so the conversion rounds down within [0, kHiddenWhole].
     const float share = samples > skip_min_samples ? skip_min_samples / samples : 1.0f;
-    out[d] = std::uint16_t(
-        std::clamp(std::floor(share * float(kHiddenWhole)), 0.0f, float(kHiddenWhole)));
+    out[d] = std::uint16_t(share * float(kHiddenWhole));
   }
 }
 
 void brick_depths(std::span<const k::ResoctLevelInfo> levels,
                   std::span<const k::ResoctSlotInfo> slots, std::vector<std::uint32_t>& out) {
-  // Without a depth that holds the level's bricks (RESOCT_NONE_U), every hidden node blocks.
-  out.assign(slots.size(), 0xFFFFFFFFu);
+  // Without a depth that holds the level's bricks (node_depth RESOCT_NONE_U, 0xFFFFFFFF), every
+  // hidden node blocks: the same value is past every depth.
+  constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  out.assign(slots.size(), kNone);
   for (std::size_t i = 0; i < slots.size(); ++i) {
     const std::uint32_t finest = slots[i].finest_level;
-    if (finest < levels.size() && levels[finest].node_depth != 0xFFFFFFFFu) {
+    if (finest < levels.size() && levels[finest].node_depth != kNone) {
       out[i] = levels[finest].node_depth;
     }
   }
