@@ -204,6 +204,10 @@ struct ResoctLevelInfo {
   // The residency-octree depth whose nodes are this level's bricks (the same level-0 boxes), the
   // standard-octree mode's culling node; RESOCT_NONE_U (0xFFFFFFFF) when no depth matches.
   uint node_depth;
+  // The deepest depth (at least the frame's start_depth) whose nodes span two voxels per axis of
+  // this level, one trilinear sample's extent: residency-mode rays sampling this level descend
+  // no deeper (host-computed, render/traversal_depths.hpp level_depth_cap).
+  uint depth_cap;
 };
 
 // One octree depth (see OctreeLayout): node (cx, cy, cz) covers voxels
@@ -228,6 +232,9 @@ struct ResoctDepthInfo {
   uint axis_bits_x;  // the bits of a local index that hold the x (y, z) coordinate: a step to
   uint axis_bits_y;  //   the neighbour along an axis is an add within them
   uint axis_bits_z;  //   (resoct_node_neighbor_local)
+  // min over the axes of node_extent / voxels_per_box: the nodes' shortest side in box units, to
+  // which a ray compares its step (host-computed, render/traversal_depths.hpp).
+  float shortest_side;
 };
 
 // What one ray reports besides its colour (summed per frame by the backend).

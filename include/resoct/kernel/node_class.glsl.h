@@ -85,15 +85,12 @@ RESOCT_FN bool resoct_node_full(uint node, RESOCT_IN(ResoctSlotInfo) s, uint nod
 }
 
 /// Deepest octree depth whose nodes are at least `dt` long on every axis (smaller nodes cannot
-/// skip more than a step), at least `start_depth`; `vpb` = level-0 voxels per box unit.
-RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, vec3 vpb, float dt) {
+/// skip more than a step), at least `start_depth`. The host stores each depth's shortest side
+/// (ResoctDepthInfo.shortest_side), so this is a compare per depth, not three divisions.
+RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, float dt) {
   uint depth = start_depth;
   for (uint d = start_depth + 1u; d < depth_count; ++d) {
-    RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
-    float sx = float(D.node_extent_x) / vpb.x;
-    float sy = float(D.node_extent_y) / vpb.y;
-    float sz = float(D.node_extent_z) / vpb.z;
-    if (min(sx, min(sy, sz)) < dt) break;
+    if (resoct_read_depth(d).shortest_side < dt) break;
     depth = d;
   }
   return depth;
@@ -101,9 +98,7 @@ RESOCT_FN uint resoct_traversal_depth_for(uint start_depth, uint depth_count, ve
 
 /// The traversal depth of a primary ray with step dt.
 RESOCT_FN uint resoct_traversal_depth(RESOCT_FRAME_IN f, float dt) {
-  return resoct_traversal_depth_for(
-      f.start_depth, f.depth_count,
-      vec3(f.voxels_per_box_x, f.voxels_per_box_y, f.voxels_per_box_z), dt);
+  return resoct_traversal_depth_for(f.start_depth, f.depth_count, dt);
 }
 
 /// log2 of the node counts per axis at depth D (counts are powers of two).
@@ -175,23 +170,6 @@ RESOCT_FN uint resoct_node_class_carried(uint node, uint depth, uint top,
     cls = resoct_node_class(resoct_read_depth(d).first_node + local, s, node_slots);
   }
   return cls;
-}
-
-/// Deepest depth (at least `start_depth`) whose nodes span at least two voxels per axis of a
-/// level with factors `factor_log2`: the extent of one trilinear sample of that level. A smaller
-/// node cannot be classified for such a sample (its value depends on voxels beyond the node), and
-/// descending to it only adds node visits that grow with the data at a fixed view.
-RESOCT_FN uint resoct_level_depth_cap(uint start_depth, uint depth_count, uvec3 factor_log2) {
-  uint depth = start_depth;
-  for (uint d = start_depth + 1u; d < depth_count; ++d) {
-    RESOCT_IN(ResoctDepthInfo) D = resoct_read_depth(d);
-    if ((D.node_extent_x >> factor_log2.x) < 2u || (D.node_extent_y >> factor_log2.y) < 2u ||
-        (D.node_extent_z >> factor_log2.z) < 2u) {
-      break;
-    }
-    depth = d;
-  }
-  return depth;
 }
 
 /// Per axis, how far inside a node (in level-0 voxels) the trilinear support of a sample of a

@@ -64,7 +64,7 @@ RESOCT_FN float resoct_shadow_transmittance(RESOCT_IN(ResoctSampleParams) sp,
   vec3 vol_lo = vec3(-cell0);
   vec3 vol_hi = vec3(ivec3(int(p.extent_x), int(p.extent_y), int(p.extent_z)) - cell0);
   float t_exit = min(resoct_ray_box_inv(frac0, inv_vox, vol_lo, vol_hi).y, max_t);
-  uint depth = resoct_traversal_depth_for(p.start_depth, p.depth_count, vpb, dt);
+  uint depth = resoct_traversal_depth_for(p.start_depth, p.depth_count, dt);
   RESOCT_IN(ResoctDepthInfo) Dt = resoct_read_depth(depth);
   uvec3 dlog2 = resoct_depth_count_log2(Dt);
 

@@ -251,7 +251,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
         uint node = 0u;
         if (mode == RESOCT_MODE_RESIDENCY) {
           // This sample's traversal depth: the ray's, capped at nodes of two voxels (a trilinear
-          // footprint) of the finest level a live channel samples here (resoct_level_depth_cap).
+          // footprint) of the finest level a live channel samples here (ResoctLevelInfo.depth_cap).
           // The LOD level changes rarely along a ray; a new slice/lens segment (ds.node
           // reset) may change the bank and with it the channels' level ranges.
           if (lod != cap_lod || ds.node == RESOCT_NONE_U) {
@@ -277,9 +277,7 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
               cap_level = lod;
               brick_depth_end = 0u;
             }
-            cap_depth = min(trav_depth, resoct_level_depth_cap(
-                                            f.start_depth, f.depth_count,
-                                            resoct_level_factor(resoct_read_level(cap_level))));
+            cap_depth = min(trav_depth, resoct_read_level(cap_level).depth_cap);
             margin = resoct_culling_margin(coarse_f);
           }
           // The traversal node of this sample (kernel/residency_descent.glsl.h).

@@ -30,7 +30,7 @@ float shortest_step(const kernel::ResoctFrame& frame);
 /// residency mode: the traversal depth of the shortest step a ray can have (an axis-aligned ray
 /// at the finest voxel size, rounded to its step level as the kernel does) capped by the depth at
 /// which nodes span two voxels of the finest level any of `slots` samples
-/// (kernel/node_class.glsl.h resoct_traversal_depth, resoct_level_depth_cap). Every ray's
+/// (render/traversal_depths.hpp, which the frame's tables and so the kernel follow). Every ray's
 /// traversal depth is at most this, since both depths only shrink as the step and level grow.
 std::uint32_t deepest_traversal_depth(const kernel::ResoctFrame& frame,
                                       std::span<const kernel::ResoctLevelInfo> levels,

@@ -21,6 +21,7 @@
 #include "resoct/scene/preintegration.hpp"
 #include "resoct/scene/step_lut.hpp"
 #include "resoct/engine/residency_octree.hpp"
+#include "resoct/render/traversal_depths.hpp"
 #include "render/frame_tables_slices.hpp"
 
 namespace resoct {
@@ -512,7 +513,12 @@ void build_frame_tables(const Scene& scene, const BrickHierarchy& hierarchy,
     D.axis_bits_x = axis_bits.x;
     D.axis_bits_y = axis_bits.y;
     D.axis_bits_z = axis_bits.z;
+    D.shortest_side = node_shortest_side(D, f);
     out.depths.push_back(D);
+  }
+  // Per level, how deep its samples can be classified (both tables are complete here).
+  for (kernel::ResoctLevelInfo& L : out.levels) {
+    L.depth_cap = level_depth_cap(out.depths, f.start_depth, L);
   }
 }
 

@@ -7,47 +7,13 @@
 
 #include "resoct/base/error.hpp"
 #include "resoct/kernel/octree_node.glsl.h"
+#include "resoct/render/traversal_depths.hpp"
 
 namespace resoct {
 
 namespace {
 
 namespace k = kernel;
-
-// The shortest side of a depth's nodes, in the frame's box units.
-float shortest_side(const k::ResoctDepthInfo& D, const k::ResoctFrame& f) {
-  return std::min(float(D.node_extent_x) / f.voxels_per_box_x,
-                  std::min(float(D.node_extent_y) / f.voxels_per_box_y,
-                           float(D.node_extent_z) / f.voxels_per_box_z));
-}
-
-// Deepest depth (at least start) whose nodes are at least `dt` long on every axis: the kernel's
-// resoct_traversal_depth_for over the host's depth table.
-std::uint32_t traversal_depth(std::span<const k::ResoctDepthInfo> depths, std::uint32_t start,
-                              const k::ResoctFrame& f, float dt) {
-  std::uint32_t depth = start;
-  for (std::uint32_t d = start + 1; d < depths.size(); ++d) {
-    if (shortest_side(depths[d], f) < dt) break;
-    depth = d;
-  }
-  return depth;
-}
-
-// Deepest depth (at least start) whose nodes span two voxels of a level with these factors: the
-// kernel's resoct_level_depth_cap.
-std::uint32_t level_depth_cap(std::span<const k::ResoctDepthInfo> depths, std::uint32_t start,
-                              const k::ResoctLevelInfo& L) {
-  std::uint32_t depth = start;
-  for (std::uint32_t d = start + 1; d < depths.size(); ++d) {
-    const k::ResoctDepthInfo& D = depths[d];
-    if ((D.node_extent_x >> L.factor_log2_x) < 2u || (D.node_extent_y >> L.factor_log2_y) < 2u ||
-        (D.node_extent_z >> L.factor_log2_z) < 2u) {
-      break;
-    }
-    depth = d;
-  }
-  return depth;
-}
 
 // The coordinate a local index holds in the bits `mask` (ResoctDepthInfo::axis_bits_*): the
 // mask's bits from the lowest up are the coordinate's from its least significant bit.
@@ -117,7 +83,7 @@ void hidden_allowance(const k::ResoctFrame& f, std::span<const k::ResoctDepthInf
   if (!(skip_min_samples > 0.0f)) return;
   const float dt = shortest_step(f);
   for (std::size_t d = 0; d < depths.size(); ++d) {
-    const float samples = shortest_side(depths[d], f) / dt;
+    const float samples = node_shortest_side(depths[d], f) / dt;
     // A node a ray crosses in fewer samples than skip_min_samples saves fewer however much of it
     // is hidden: the whole fraction (an EMPTY node itself still gets no bit). share is in (0, 1],
     // so the conversion rounds down within [0, kHiddenWhole].

@@ -1,9 +1,10 @@
-// What RESOCT_KERNEL_LAYOUT_VERSION 5 means (2: ResoctFrame gained the jitter; 4:
+// What RESOCT_KERNEL_LAYOUT_VERSION 7 means (2: ResoctFrame gained the jitter; 4:
 // ResoctLevelInfo gained node_depth, the standard-octree mode's culling node; 5: ResoctFrame
 // gained the step levels of kernel/step_lut.glsl.h; 6: ResoctSlotInfo gained lod_error_code and
-// MAPPED / HOMOGENEOUS page entries an error code in bits 26-29): the sizes of the
-// records the host shares with the device and the encodings of their packed words. A change to any
-// of them fails here until the version is incremented and this table updated
+// MAPPED / HOMOGENEOUS page entries an error code in bits 26-29; 7: ResoctLevelInfo gained
+// depth_cap and ResoctDepthInfo shortest_side, the traversal's depth rules precomputed): the sizes
+// of the records the host shares with the device and the encodings of their packed words. A change
+// to any of them fails here until the version is incremented and this table updated
 // (kernel/layout_version.glsl.h), so applications and backends built against another layout can
 // tell.
 #include <gtest/gtest.h>
@@ -23,14 +24,14 @@ namespace {
 namespace k = resoct::kernel;
 
 TEST(KernelLayoutVersion, RecordsAreThoseOfTheDeclaredVersion) {
-  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 6u)
+  ASSERT_EQ(k::RESOCT_KERNEL_LAYOUT_VERSION, 7u)
       << "the layout version changed: update the table of this test to the new layout";
   const char* bump = "a shared record changed: increment RESOCT_KERNEL_LAYOUT_VERSION";
   EXPECT_EQ(sizeof(k::ResoctFrame), 524u) << bump;
   EXPECT_EQ(sizeof(k::ResoctFxFrame), 44u) << bump;
   EXPECT_EQ(sizeof(k::ResoctSlotInfo), 68u) << bump;
-  EXPECT_EQ(sizeof(k::ResoctLevelInfo), 44u) << bump;
-  EXPECT_EQ(sizeof(k::ResoctDepthInfo), 68u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctLevelInfo), 48u) << bump;
+  EXPECT_EQ(sizeof(k::ResoctDepthInfo), 72u) << bump;
   EXPECT_EQ(sizeof(k::ResoctRayStats), 40u) << bump;
   EXPECT_EQ(sizeof(PageDelta), 8u) << bump;
   EXPECT_EQ(sizeof(OctreeWordDelta), 8u) << bump;
