@@ -20,48 +20,46 @@ double region_spread(const BrickSource& source, std::uint32_t channel, const Box
   return m.max - m.min;
 }
 
-// Trilinear reconstruction of the padded brick at index-space position u (voxel centres at
-// integers), clamped to the brick: what the kernel's sampler computes through the halo.
-class PaddedBrick {
- public:
-  PaddedBrick(std::span<const std::byte> voxels, glm::uvec3 size, VoxelType type)
-      : size_(size), values_(std::size_t(size.x) * size.y * size.z) {
-    const std::size_t vs = voxel_size(type);
-    for (std::size_t i = 0; i < values_.size(); ++i) {
-      values_[i] = voxel_value(voxels.data() + i * vs, type);
-    }
-  }
+// The padded brick's voxels as doubles, x fastest.
+std::vector<double> padded_values(std::span<const std::byte> voxels, glm::uvec3 size,
+                                  VoxelType type) {
+  std::vector<double> out(std::size_t(size.x) * size.y * size.z);
+  const std::size_t vs = voxel_size(type);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = voxel_value(voxels.data() + i * vs, type);
+  return out;
+}
 
-  double at(glm::dvec3 u) const {
-    int i0[3];
-    double w[3];
-    for (int a = 0; a < 3; ++a) {
-      const double c = std::clamp(u[a], 0.0, double(size_[a] - 1));
-      i0[a] = std::min(int(std::floor(c)), int(size_[a]) - 2);
-      w[a] = c - double(i0[a]);
-    }
-    double sum = 0.0;
-    for (int k = 0; k < 8; ++k) {
-      const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
-      const double wk =
-          (dx ? w[0] : 1.0 - w[0]) * (dy ? w[1] : 1.0 - w[1]) * (dz ? w[2] : 1.0 - w[2]);
-      if (wk == 0.0) continue;
-      sum += wk * value(i0[0] + dx, i0[1] + dy, i0[2] + dz);
-    }
-    return sum;
-  }
-
- private:
-  double value(int x, int y, int z) const {
-    x = std::min(x, int(size_.x) - 1);
-    y = std::min(y, int(size_.y) - 1);
-    z = std::min(z, int(size_.z) - 1);
-    return values_[std::size_t(x) + size_.x * (std::size_t(y) + std::size_t(size_.y) * z)];
-  }
-
-  glm::uvec3 size_;
-  std::vector<double> values_;
+// The trilinear reconstruction (kernel's sampler through the halo) factors into one weight per
+// axis: along an axis, level-0 coordinate x lies at padded index-space position
+// u = (x - core_lo0 + 1/2) 2^-f + halo - 1/2 (voxel centres at integers), clamped to the brick,
+// between voxels i0 and i0 + 1 with weight w on the second. Tabled per coordinate of the box.
+struct AxisTaps {
+  std::int64_t lo = 0;          // first level-0 coordinate tabled
+  std::vector<std::int32_t> i0;  // per coordinate: the lower voxel
+  std::vector<double> w;         // and the upper voxel's weight, in [0, 1]
 };
+
+AxisTaps axis_taps(std::int64_t lo, std::int64_t hi, double core_lo0, double scale, double halo,
+                   std::uint32_t size) {
+  AxisTaps t;
+  t.lo = lo;
+  for (std::int64_t x = lo; x < hi; ++x) {
+    const double u = (double(x) - core_lo0 + 0.5) * scale + halo - 0.5;
+    const double c = std::clamp(u, 0.0, double(size - 1));
+    const int i0 = std::min(int(std::floor(c)), int(size) - 2);
+    t.i0.push_back(i0);
+    t.w.push_back(c - double(i0));
+  }
+  return t;
+}
+
+// (1 - w) a + w b over the taps whose weight is not zero: a NaN voxel the reconstruction gives
+// no weight does not reach the result.
+double lerp_taps(double a, double b, double w) noexcept {
+  if (w == 0.0) return a;
+  if (w == 1.0) return b;
+  return (1.0 - w) * a + w * b;
+}
 
 }  // namespace
 
@@ -117,17 +115,21 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
     return bound;
   }
 
-  const PaddedBrick coarse(padded, layout.padded_size(), v.type);
-  const Box3 core = h.core_box(level, key.brick());
-  const glm::dvec3 scale(std::ldexp(1.0, -int(li.factor_log2.x)),
-                         std::ldexp(1.0, -int(li.factor_log2.y)),
-                         std::ldexp(1.0, -int(li.factor_log2.z)));
-  const glm::dvec3 core_lo0(double(core.lo.x << li.factor_log2.x),
-                            double(core.lo.y << li.factor_log2.y),
-                            double(core.lo.z << li.factor_log2.z));
-  const double halo = double(layout.halo);
   const glm::uvec3 bs = layout.brick_size;
   const glm::uvec3 ps = layout.padded_size();
+  const std::vector<double> coarse = padded_values(padded, ps, v.type);
+  const Box3 core = h.core_box(level, key.brick());
+  const double halo = double(layout.halo);
+  AxisTaps taps[3];
+  for (int a = 0; a < 3; ++a) {
+    taps[a] = axis_taps(box0.lo[a], box0.hi[a], double(core.lo[a] << li.factor_log2[a]),
+                        std::ldexp(1.0, -int(li.factor_log2[a])), halo, ps[a]);
+  }
+  // Separable passes per level-0 brick: the coarse voxels its box needs interpolated along z per
+  // level-0 z (a slab), the slab along y per level-0 row, the row along x per voxel; one lerp
+  // per level-0 voxel instead of eight weighted taps.
+  std::vector<double> slab;
+  std::vector<double> row;
   std::vector<std::byte> fine(layout.padded_voxels() * vs);
   double worst = 0.0;
   // The level-0 bricks under the footprint, each read whole and compared at its core voxels.
@@ -140,21 +142,46 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
         const glm::uvec3 b{std::uint32_t(bx), std::uint32_t(by), std::uint32_t(bz)};
         source.read_brick(BrickKey(0, key.channel(), b), fine);
         const Box3 c0 = h.core_box(0, b);
-        for (std::int64_t z = std::max(c0.lo.z, box0.lo.z); z < std::min(c0.hi.z, box0.hi.z); ++z) {
-          for (std::int64_t y = std::max(c0.lo.y, box0.lo.y); y < std::min(c0.hi.y, box0.hi.y);
-               ++y) {
-            for (std::int64_t x = std::max(c0.lo.x, box0.lo.x); x < std::min(c0.hi.x, box0.hi.x);
-                 ++x) {
-              const std::size_t i =
-                  std::size_t(x - c0.lo.x + layout.halo) +
-                  ps.x * (std::size_t(y - c0.lo.y + layout.halo) +
-                          std::size_t(ps.y) * std::size_t(z - c0.lo.z + layout.halo));
+        const glm::i64vec3 lo = glm::max(c0.lo, box0.lo);
+        const glm::i64vec3 hi = glm::min(c0.hi, box0.hi);
+        if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) continue;
+        // The coarse voxels these level-0 voxels interpolate: [cx0, cx1] x [cy0, cy1].
+        const int cx0 = taps[0].i0[std::size_t(lo.x - taps[0].lo)];
+        const int cx1 = taps[0].i0[std::size_t(hi.x - 1 - taps[0].lo)] + 1;
+        const int cy0 = taps[1].i0[std::size_t(lo.y - taps[1].lo)];
+        const int cy1 = taps[1].i0[std::size_t(hi.y - 1 - taps[1].lo)] + 1;
+        const std::size_t nx = std::size_t(cx1 - cx0 + 1);
+        const std::size_t ny = std::size_t(cy1 - cy0 + 1);
+        slab.resize(nx * ny);
+        row.resize(nx);
+        for (std::int64_t z = lo.z; z < hi.z; ++z) {
+          const std::size_t tz = std::size_t(z - taps[2].lo);
+          const std::size_t z0 = std::size_t(taps[2].i0[tz]);
+          const double wz = taps[2].w[tz];
+          for (std::size_t y = 0; y < ny; ++y) {
+            const std::size_t r0 = std::size_t(cx0) + ps.x * (std::size_t(cy0) + y + ps.y * z0);
+            const std::size_t r1 = r0 + std::size_t(ps.x) * ps.y;
+            for (std::size_t x = 0; x < nx; ++x) {
+              slab[x + nx * y] = lerp_taps(coarse[r0 + x], coarse[r1 + x], wz);
+            }
+          }
+          for (std::int64_t y = lo.y; y < hi.y; ++y) {
+            const std::size_t ty = std::size_t(y - taps[1].lo);
+            const std::size_t y0 = std::size_t(taps[1].i0[ty] - cy0);
+            const double wy = taps[1].w[ty];
+            for (std::size_t x = 0; x < nx; ++x) {
+              row[x] = lerp_taps(slab[x + nx * y0], slab[x + nx * (y0 + 1)], wy);
+            }
+            const std::size_t line =
+                ps.x * (std::size_t(y - c0.lo.y + layout.halo) +
+                        std::size_t(ps.y) * std::size_t(z - c0.lo.z + layout.halo));
+            for (std::int64_t x = lo.x; x < hi.x; ++x) {
+              const std::size_t i = std::size_t(x - c0.lo.x + layout.halo) + line;
               const double v0 = voxel_value(fine.data() + i * vs, v.type);
               if (std::isnan(v0)) continue;
-              const glm::dvec3 p =
-                  (glm::dvec3(double(x), double(y), double(z)) - core_lo0 + 0.5) * scale + halo -
-                  0.5;
-              const double r = coarse.at(p);
+              const std::size_t tx = std::size_t(x - taps[0].lo);
+              const std::size_t x0 = std::size_t(taps[0].i0[tx] - cx0);
+              const double r = lerp_taps(row[x0], row[x0 + 1], taps[0].w[tx]);
               if (std::isnan(r)) continue;
               worst = std::max(worst, std::abs(r - v0));
             }

@@ -3,6 +3,7 @@
 // region-spread bound above the budget, and the page entry's error code.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -102,6 +103,94 @@ TEST(BrickError, MeasuresTheTrilinearReconstructionAtVoxelCentres) {
   // voxel holds 1/64, level 2's 2/64, the first level-0 voxel 0.5/64.
   EXPECT_NEAR(error_of(s, BrickKey(1, 0, {0, 0, 0})), 0.5 / 64.0, 1e-6);
   EXPECT_NEAR(error_of(s, BrickKey(2, 0, {0, 0, 0})), 1.5 / 64.0, 1e-6);
+}
+
+// The definition spelt out, independently of the measurement's separable passes: at every
+// level-0 voxel centre under the brick, the eight-tap trilinear reconstruction of the padded
+// brick (taps of weight zero left out, so a NaN there does not count) against the level-0 voxel
+// read from the volume itself; the largest difference over the range's width.
+double reference_error(const InMemorySource& s, const std::vector<double>& level0, BrickKey key) {
+  const BrickHierarchy& h = s.hierarchy();
+  const BrickLayout& layout = h.layout();
+  const glm::uvec3 ps = layout.padded_size();
+  const std::vector<std::byte> raw = padded(s, key);
+  const VoxelType type = s.volume().type;
+  const auto coarse = [&](int x, int y, int z) {
+    return voxel_value(raw.data() + (std::size_t(x) + ps.x * (std::size_t(y) + ps.y * std::size_t(z))) *
+                                        voxel_size(type),
+                       type);
+  };
+  const glm::uvec3 f = h.level(key.level()).factor_log2;
+  const Box3 core = h.core_box(key.level(), key.brick());
+  const Box3 box0 = h.level0_box(key.level(), key.brick());
+  const glm::u64vec3 e = s.volume().extent;
+  double worst = 0.0;
+  for (std::int64_t z = box0.lo.z; z < box0.hi.z; ++z) {
+    for (std::int64_t y = box0.lo.y; y < box0.hi.y; ++y) {
+      for (std::int64_t x = box0.lo.x; x < box0.hi.x; ++x) {
+        const double v0 = level0[std::size_t(x) + e.x * (std::size_t(y) + e.y * std::size_t(z))];
+        if (std::isnan(v0)) continue;
+        const std::int64_t p0[3] = {x, y, z};
+        int i0[3];
+        double w[3];
+        for (int a = 0; a < 3; ++a) {
+          const double u = (double(p0[a] - (core.lo[a] << f[a])) + 0.5) / double(1u << f[a]) +
+                           double(layout.halo) - 0.5;
+          const double c = std::clamp(u, 0.0, double(ps[a] - 1));
+          i0[a] = std::min(int(c), int(ps[a]) - 2);
+          w[a] = c - i0[a];
+        }
+        double r = 0.0;
+        for (int k = 0; k < 8; ++k) {
+          const int d[3] = {k & 1, (k >> 1) & 1, (k >> 2) & 1};
+          double wk = 1.0;
+          for (int a = 0; a < 3; ++a) wk *= d[a] ? w[a] : 1.0 - w[a];
+          if (wk != 0.0) r += wk * coarse(i0[0] + d[0], i0[1] + d[1], i0[2] + d[2]);
+        }
+        if (!std::isnan(r)) worst = std::max(worst, std::abs(r - v0));
+      }
+    }
+  }
+  const ValueRange range = s.volume().range(key.channel());
+  return std::min(1.0, worst / (range.hi - range.lo));
+}
+
+// Every brick of every coarse level of volumes whose extents are no multiple of the brick, against
+// the definition: exactly for u8 (weights of 2^-k and small integers are exact in doubles, in any
+// order), to rounding for f32 with NaN voxels.
+TEST(BrickError, EveryCoarseBrickIsTheDefinitionsError) {
+  const glm::u64vec3 e(37, 29, 23);
+  const std::size_t n = std::size_t(e.x * e.y * e.z);
+  std::mt19937 rng(11);
+  std::vector<std::uint8_t> bytes(n);
+  std::vector<float> floats(n);
+  std::vector<double> bytes_d(n), floats_d(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    // Smooth along x (so that codes vary), noisy elsewhere.
+    bytes[i] = std::uint8_t((i % e.x) * 6 + rng() % 16);
+    floats[i] = rng() % 97 == 0 ? std::numeric_limits<float>::quiet_NaN()
+                                : float(std::sin(double(i % e.x) * 0.3) + double(rng() % 100) * 1e-3);
+    bytes_d[i] = bytes[i];
+    floats_d[i] = floats[i];
+  }
+  const InMemorySource s8 = source_of(e, VoxelType::u8, bytes);
+  const InMemorySource s32 = source_of(e, VoxelType::f32, floats);
+  int checked = 0;
+  for (std::uint32_t l = 1; l < s8.hierarchy().level_count(); ++l) {
+    const glm::uvec3 nb = s8.hierarchy().level(l).bricks;
+    for (std::uint32_t z = 0; z < nb.z; ++z) {
+      for (std::uint32_t y = 0; y < nb.y; ++y) {
+        for (std::uint32_t x = 0; x < nb.x; ++x) {
+          const BrickKey key(l, 0, {x, y, z});
+          ASSERT_EQ(error_of(s8, key), reference_error(s8, bytes_d, key)) << "u8 level " << l;
+          const double ref = reference_error(s32, floats_d, key);
+          ASSERT_NEAR(error_of(s32, key), ref, 1e-12 * (1.0 + ref)) << "f32 level " << l;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 8);
 }
 
 TEST(BrickError, AboveTheBudgetTheRegionSpreadBoundsIt) {
