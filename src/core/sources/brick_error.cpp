@@ -34,7 +34,7 @@ std::vector<double> padded_values(std::span<const std::byte> voxels, glm::uvec3 
 // u = (x - core_lo0 + 1/2) 2^-f + halo - 1/2 (voxel centres at integers), clamped to the brick,
 // between voxels i0 and i0 + 1 with weight w on the second. Tabled per coordinate of the box.
 struct AxisTaps {
-  std::int64_t lo = 0;          // first level-0 coordinate tabled
+  std::int64_t lo = 0;           // first level-0 coordinate tabled
   std::vector<std::int32_t> i0;  // per coordinate: the lower voxel
   std::vector<double> w;         // and the upper voxel's weight, in [0, 1]
 };

@@ -116,9 +116,10 @@ double reference_error(const InMemorySource& s, const std::vector<double>& level
   const std::vector<std::byte> raw = padded(s, key);
   const VoxelType type = s.volume().type;
   const auto coarse = [&](int x, int y, int z) {
-    return voxel_value(raw.data() + (std::size_t(x) + ps.x * (std::size_t(y) + ps.y * std::size_t(z))) *
-                                        voxel_size(type),
-                       type);
+    return voxel_value(
+        raw.data() +
+            (std::size_t(x) + ps.x * (std::size_t(y) + ps.y * std::size_t(z))) * voxel_size(type),
+        type);
   };
   const glm::uvec3 f = h.level(key.level()).factor_log2;
   const Box3 core = h.core_box(key.level(), key.brick());
@@ -168,8 +169,9 @@ TEST(BrickError, EveryCoarseBrickIsTheDefinitionsError) {
   for (std::size_t i = 0; i < n; ++i) {
     // Smooth along x (so that codes vary), noisy elsewhere.
     bytes[i] = std::uint8_t((i % e.x) * 6 + rng() % 16);
-    floats[i] = rng() % 97 == 0 ? std::numeric_limits<float>::quiet_NaN()
-                                : float(std::sin(double(i % e.x) * 0.3) + double(rng() % 100) * 1e-3);
+    floats[i] = rng() % 97 == 0
+                    ? std::numeric_limits<float>::quiet_NaN()
+                    : float(std::sin(double(i % e.x) * 0.3) + double(rng() % 100) * 1e-3);
     bytes_d[i] = bytes[i];
     floats_d[i] = floats[i];
   }
