@@ -128,6 +128,43 @@ TEST(FrameTables, SamplingConstants) {
   EXPECT_LT(t.frame.min_step, 1e-3f * t.frame.ref_step);
 }
 
+// The residency traversal's depth rules, tabled per frame (render/traversal_depths.hpp): each
+// depth's shortest node side in box units, and per level the deepest depth (from start_depth on)
+// whose nodes span two of its voxels per axis, spelt out here from the layout.
+TEST(FrameTables, TraversalDepthRulesAreTabledPerDepthAndLevel) {
+  VolumeDesc v;
+  v.extent = {1024, 512, 128};
+  v.spacing = {1.0, 1.0, 4.0};
+  Fixture fx(v);
+  FrameOptions options;
+  options.start_depth = 1;
+  const FrameTables t = build_frame_tables(scene_with(Camera{}, {16, 16}), fx.hierarchy, fx.layout,
+                                           fx.channels, options);
+  const std::uint32_t depths = fx.layout.depth_count();
+  ASSERT_GE(depths, 4u);
+  for (std::uint32_t d = 0; d < depths; ++d) {
+    const glm::u64vec3 ne = fx.layout.depth(d).node_extent;
+    const float side =
+        std::min({float(ne.x) / t.frame.voxels_per_box_x, float(ne.y) / t.frame.voxels_per_box_y,
+                  float(ne.z) / t.frame.voxels_per_box_z});
+    EXPECT_EQ(t.depths[d].shortest_side, side) << "depth " << d;
+  }
+  std::uint32_t distinct = 0;
+  for (std::uint32_t l = 0; l < fx.hierarchy.level_count(); ++l) {
+    const glm::uvec3 f = fx.hierarchy.level(l).factor_log2;
+    std::uint32_t cap = 1;
+    while (cap + 1 < depths) {
+      const glm::u64vec3 ne = fx.layout.depth(cap + 1).node_extent;
+      if ((ne.x >> f.x) < 2 || (ne.y >> f.y) < 2 || (ne.z >> f.z) < 2) break;
+      ++cap;
+    }
+    EXPECT_EQ(t.levels[l].depth_cap, cap) << "level " << l;
+    if (l > 0 && t.levels[l].depth_cap != t.levels[l - 1].depth_cap) ++distinct;
+  }
+  EXPECT_EQ(t.levels[0].depth_cap, depths - 1) << "level 0: every depth's nodes span two voxels";
+  EXPECT_GT(distinct, 0u) << "the volume should give coarse levels shallower caps";
+}
+
 // The step follows the finest level any sample can pick (docs/rendering.md, "Step size"):
 // brute force over a grid of points in the volume, each point's level by the LOD rule's
 // definition (coarsest level whose voxel fits the pixel footprint at its view depth).
