@@ -16,10 +16,11 @@ void VisibleSubtreeTracker::note_sent(const OctreeDeltas& deltas, bool full,
   if (rebuild_) return;
   const std::uint32_t record_words = kernel::RESOCT_NODE_WORDS * node_slots;
   for (const OctreeWordDelta& d : deltas.words) {
+    // Flags and ranges decide what a node hides; residency words whether a hidden node of only
+    // zeros is resident EMPTY pages (VisibleSubtreeBuilder::empty_pages); the builder does not
+    // read the occupancy word.
     const std::uint32_t which = d.index % kernel::RESOCT_NODE_WORDS;
-    if (which == kernel::RESOCT_NODE_FLAGS || which == kernel::RESOCT_NODE_MINMAX) {
-      changed_nodes_.push_back(d.index / record_words);
-    }
+    if (which != kernel::RESOCT_NODE_OCCUPANCY) changed_nodes_.push_back(d.index / record_words);
   }
 }
 

@@ -134,6 +134,41 @@ void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables,
       bricks);
 }
 
+// Whether a hidden node (record at `base`, entry i) consists of whole bricks of the entry's finest
+// level that are resident as EMPTY pages (only zeros) at every level the entry samples: a march
+// below a set bit finds their page entries EMPTY and skips each brick at one lookup, as the page
+// table does, and requests nothing. At the depth of the finest level's bricks the record must say
+// "only zeros" (VALID, [0, 0], the entry's raw 0 being its normalized 0) and its residency word
+// every level from the finest to the coarsest: the node lies inside exactly one brick of each
+// (partial residency is the whole brick there). Above that depth every child must be such a node.
+bool VisibleSubtreeBuilder::empty_pages(std::span<const std::uint32_t> words, std::uint32_t base,
+                                        std::uint32_t depth, std::uint32_t i, bool inner,
+                                        std::uint32_t first, std::uint32_t children) const {
+  if (brick_depth_.empty() || depth > brick_depth_[i]) return false;
+  const k::ResoctSlotInfo& s = slots_[i];
+  if (!(s.zero_value == 0.0f)) return false;
+  if (k::resoct_node_state(words[base + k::RESOCT_NODE_FLAGS]) != k::RESOCT_NODE_VALID ||
+      words[base + k::RESOCT_NODE_MINMAX] != k::resoct_node_pack_minmax(0u, 0u)) {
+    return false;
+  }
+  if (depth == brick_depth_[i]) {
+    if (s.coarsest_level >= 32u || s.finest_level > s.coarsest_level) return false;
+    const std::uint32_t span = s.coarsest_level - s.finest_level + 1u;
+    const std::uint32_t levels = (span >= 32u ? 0xFFFFFFFFu : ((1u << span) - 1u))
+                                 << s.finest_level;
+    return (words[base + k::RESOCT_NODE_RESIDENCY] & levels) == levels;
+  }
+  if (!inner) return false;
+  const std::uint32_t entries = std::uint32_t(slots_.size());
+  for (std::uint32_t c = 0; c < children; ++c) {
+    if ((known_[first + c] & (1u << i)) == 0u || hidden_[(first + c) * entries + i] != 0u ||
+        (blocked_[first + c] & (1u << i)) != 0u) {
+      return false;
+    }
+  }
+  return true;
+}
+
 // A node's mask, word and hidden fractions from its record and its children's (the children's
 // first, when the node is above the depth limit). The limit's own nodes are checked but their
 // children are not: no ray descends past them, and they get no word.
@@ -168,8 +203,10 @@ VisibleSubtreeBuilder::NodeResult VisibleSubtreeBuilder::compute(
     if (!k::resoct_node_range_visible(minmax, slots_[i].vis_lo16, slots_[i].vis_hi16,
                                       slots_[i].vis_bins)) {
       // Hidden: wholly, and what lies below it is never read (the descent skips it; below a
-      // set bit it is sampled, transparent). Whole bricks hidden are never widened over.
+      // set bit it is sampled, transparent). Whole bricks hidden are never widened over, unless
+      // they are resident EMPTY pages, which a march below a set bit skips as cheaply.
       known |= bit;
+      if (empty_pages(words, base, depth, i, inner, first, children)) continue;  // hides nothing
       hidden[i] = std::uint16_t(kHiddenWhole);
       if (!brick_depth_.empty() && depth <= brick_depth_[i]) blocked |= bit;
       continue;

@@ -261,6 +261,61 @@ TEST(VisibleSubtreesAllowance, HiddenNodesOfWholeBricksKeepTheirAncestorsBitsCle
   EXPECT_EQ(depth, (std::vector<std::uint32_t>{2u, 0xFFFFFFFFu}));
 }
 
+// Hidden nodes of whole bricks that are resident EMPTY pages (only zeros) at every level the entry
+// samples hide nothing: a march below a set bit skips each such brick at its page entry, as the
+// page table does, and requests nothing.
+TEST(VisibleSubtreesAllowance, ResidentEmptyPagesHideNothing) {
+  const std::vector<std::uint32_t> leaves_are_bricks{2}, parents_are_bricks{1};
+  const auto residency = [](Tree& t, std::uint32_t node, std::uint32_t levels) {
+    t.words[node * k::RESOCT_NODE_WORDS + k::RESOCT_NODE_RESIDENCY] = levels;
+  };
+  const auto bits = [](const Tree& t, const k::ResoctSlotInfo& s,
+                       const std::vector<std::uint32_t>& brick_depth) {
+    std::vector<std::uint32_t> out;
+    build_visible_subtrees(t.words, 1, depths(), std::vector{s}, glm::uvec3(32u), 0, 2, out, {},
+                           brick_depth);
+    return out;
+  };
+  k::ResoctSlotInfo s = shows_from(0.1);
+  Tree t;
+  t.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.0);
+  EXPECT_EQ(bits(t, s, leaves_are_bricks)[0], 0u) << "not resident: the march would request it";
+  residency(t, kLeaf, 0b1u);
+  EXPECT_EQ(bits(t, s, leaves_are_bricks)[0], 1u);
+  EXPECT_EQ(bits(t, s, leaves_are_bricks)[kLeafParent], 1u);
+  EXPECT_EQ(bits(t, s, {})[0], 0u) << "without brick depths no page is known to be EMPTY";
+  EXPECT_EQ(bits(t, s, parents_are_bricks)[0], 0u) << "an eighth of a brick: not an EMPTY page";
+  k::ResoctSlotInfo coarse = s;
+  coarse.coarsest_level = 1;
+  EXPECT_EQ(bits(t, coarse, leaves_are_bricks)[0], 0u) << "level 1 is not resident";
+  residency(t, kLeaf, 0b11u);
+  EXPECT_EQ(bits(t, coarse, leaves_are_bricks)[0], 1u);
+  k::ResoctSlotInfo offset = s;
+  offset.zero_value = -0.25f;  // raw 0 is not the range's bottom: [0, 0] is no EMPTY page
+  EXPECT_EQ(bits(t, offset, leaves_are_bricks)[0], 0u);
+  Tree low;
+  low.set(kLeaf, k::RESOCT_NODE_VALID, 0.0, 0.05);  // hidden, but not only zeros
+  residency(low, kLeaf, 0b1u);
+  EXPECT_EQ(bits(low, s, leaves_are_bricks)[0], 0u);
+  Tree approx;
+  approx.set(kLeaf, k::RESOCT_NODE_APPROX, 0.0, 0.0);  // may be too narrow
+  residency(approx, kLeaf, 0b1u);
+  EXPECT_EQ(bits(approx, s, leaves_are_bricks)[0], 0u);
+  // A node above the bricks is free when every child is.
+  Tree above;
+  above.set(kLeafParent, k::RESOCT_NODE_VALID, 0.0, 0.0);
+  for (std::uint32_t c = 0; c < 8; ++c) {
+    const std::uint32_t leaf = 9 + 3 * 8 + c;  // the children of depth-1 local 3
+    above.set(leaf, k::RESOCT_NODE_VALID, 0.0, 0.0);
+    residency(above, leaf, c == 5 ? 0u : 0b1u);
+  }
+  EXPECT_EQ(bits(above, s, leaves_are_bricks)[0], 0u) << "one child's brick is not resident";
+  residency(above, 9 + 3 * 8 + 5, 0b1u);
+  EXPECT_EQ(bits(above, s, leaves_are_bricks)[0], 1u);
+  residency(above, kLeafParent, 0b1u);
+  EXPECT_EQ(bits(above, s, parents_are_bricks)[0], 1u) << "the parent is the brick";
+}
+
 // The depth limit is the deepest traversal depth of any ray: an axis-aligned ray's step, and the
 // finest level any shown entry samples.
 TEST(VisibleSubtreesLimits, TheDepthLimitFollowsTheShortestStepAndTheFinestLevel) {
@@ -296,29 +351,39 @@ TEST(VisibleSubtreeUpdates, GiveWhatAFullBuildOfTheChangedRecordsGives) {
   std::mt19937 rng(20261128);
   auto draw = [&rng](std::uint32_t n) { return std::uint32_t(rng() % n); };
   const std::vector<std::vector<std::uint16_t>> allowances = {{}, {3000, 20000, 65535}};
-  for (const std::vector<std::uint16_t>& allowance : allowances) {
+  // Without brick depths, and with entry 0's bricks at depth 1 and entry 1's at the leaves, where
+  // resident EMPTY pages hide nothing.
+  const std::vector<std::vector<std::uint32_t>> brick_depths = {{}, {}, {1, 2}};
+  for (std::size_t variant = 0; variant < brick_depths.size(); ++variant) {
+    const std::vector<std::uint16_t>& allowance = allowances[std::min<std::size_t>(variant, 1)];
+    const std::vector<std::uint32_t>& brick_depth = brick_depths[variant];
     for (std::uint32_t start = 0; start < 2; ++start) {
       for (std::uint32_t limit = start + 1; limit < 3; ++limit) {
         std::vector<std::uint32_t> words(kNodes * kSlots * k::RESOCT_NODE_WORDS, 0u);
         auto set_random = [&](std::uint32_t node) {
           for (std::uint32_t s = 0; s < kSlots; ++s) {
             const std::uint32_t base = k::resoct_node_base(node, s, kSlots);
-            // Mostly shown ranges, so that bits exist for changes to clear; some hidden, unknown
-            // and homogeneous ones.
+            // Mostly shown ranges, so that bits exist for changes to clear; some hidden, unknown,
+            // homogeneous ones, and only zeros, resident or not.
             const std::uint32_t kind = draw(24);
             const std::uint32_t lo = kind == 0   ? draw(6000)
                                      : kind == 1 ? 30000u
+                                     : kind == 3 ? 0u
                                                  : 20000u + draw(20000);
-            const std::uint32_t hi = kind == 0 ? lo + draw(100) : kind == 1 ? lo : lo + draw(20000);
+            const std::uint32_t hi = kind == 0                ? lo + draw(100)
+                                     : kind == 1 || kind == 3 ? lo
+                                                              : lo + draw(20000);
             words[base + k::RESOCT_NODE_FLAGS] = k::resoct_node_make_flags(
                 kind == 2 ? k::RESOCT_NODE_INVALID : k::RESOCT_NODE_VALID, 0u);
             words[base + k::RESOCT_NODE_MINMAX] = k::resoct_node_pack_minmax(lo, hi);
+            words[base + k::RESOCT_NODE_RESIDENCY] = draw(4) == 0 ? 0u : 1u;
           }
         };
         for (std::uint32_t n = 0; n < kNodes; ++n) set_random(n);
         VisibleSubtreeBuilder builder;
         std::vector<std::uint32_t> kept;
-        builder.build(words, kSlots, depths(), entries, extent, start, limit, kept, allowance);
+        builder.build(words, kSlots, depths(), entries, extent, start, limit, kept, allowance,
+                      brick_depth);
         std::uint64_t changed_words = 0;
         for (int round = 0; round < 300; ++round) {
           std::vector<std::uint32_t> changed(1 + draw(4));
@@ -330,9 +395,9 @@ TEST(VisibleSubtreeUpdates, GiveWhatAFullBuildOfTheChangedRecordsGives) {
           changed_words += builder.update(words, changed, kept).words_changed;
           std::vector<std::uint32_t> fresh;
           build_visible_subtrees(words, kSlots, depths(), entries, extent, start, limit, fresh,
-                                 allowance);
+                                 allowance, brick_depth);
           ASSERT_EQ(kept, fresh) << "start " << start << ", limit " << limit << ", round " << round
-                                 << ", allowance " << allowance.size();
+                                 << ", variant " << variant;
         }
         EXPECT_GE(changed_words, 10u)
             << "the rounds must change bits for the check to mean anything";
