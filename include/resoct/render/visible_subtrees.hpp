@@ -73,11 +73,11 @@ void brick_depths(std::span<const kernel::ResoctLevelInfo> levels,
 ///   below hidden; hidden_allowance()), and no hidden node below at a depth at or above the
 ///   entry's `brick_depth` (brick_depths(); empty: none such). A hidden node below a set bit is
 ///   sampled instead of skipped, and its samples are transparent; being smaller than a brick, it
-///   lies inside one whose record is not hidden. A hidden node of whole bricks that are resident
-///   EMPTY pages (only zeros: a VALID [0, 0] record, the entry's zero_value 0, and at the brick
-///   depth a residency word with every level from the entry's finest to its coarsest; above it,
-///   every child such a node) hides nothing and blocks nothing: a march skips those bricks at
-///   their page entries.
+///   lies inside one whose record is not hidden. A hidden node of whole bricks of the finest level
+///   that are resident EMPTY pages, the coarser levels' bricks there resident too (a VALID [0, 0]
+///   record, the entry's zero_value 0, and at the brick depth a residency word with every level
+///   from the entry's finest to its coarsest; above it, every child such a node), hides nothing
+///   and blocks nothing: a march skips those bricks at their page entries, requesting nothing.
 /// Nodes wholly outside the volume [0, `extent`) (level-0 voxels), which no ray reaches, count as
 /// shown. Nodes at depths below `start_depth` or at and below `depth_limit` get 0. `words` are
 /// ResidencyOctree::words() with `node_slots` records per node (kernel/octree_node.glsl.h).

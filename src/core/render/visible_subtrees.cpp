@@ -135,12 +135,14 @@ void build_visible_subtrees(const ResidencyOctree& octree, FrameTables& tables,
 }
 
 // Whether a hidden node (record at `base`, entry i) consists of whole bricks of the entry's finest
-// level that are resident as EMPTY pages (only zeros) at every level the entry samples: a march
-// below a set bit finds their page entries EMPTY and skips each brick at one lookup, as the page
-// table does, and requests nothing. At the depth of the finest level's bricks the record must say
-// "only zeros" (VALID, [0, 0], the entry's raw 0 being its normalized 0) and its residency word
-// every level from the finest to the coarsest: the node lies inside exactly one brick of each
-// (partial residency is the whole brick there). Above that depth every child must be such a node.
+// level that are resident EMPTY pages (only zeros), with the bricks of every coarser level the
+// entry samples resident: a march below a set bit finds the finest level's page entries EMPTY and
+// skips each brick at one lookup, as the page table does (at a coarser level it samples the
+// resident brick, as the page table does), and requests nothing. At the depth of the finest level's
+// bricks the record must say "only zeros" (VALID, [0, 0], the entry's raw 0 being its normalized 0)
+// and its residency word every level from the finest to the coarsest: the node lies inside exactly
+// one brick of each (partial residency is the whole brick there). Above that depth every child must
+// be such a node.
 bool VisibleSubtreeBuilder::empty_pages(std::span<const std::uint32_t> words, std::uint32_t base,
                                         std::uint32_t depth, std::uint32_t i, bool inner,
                                         std::uint32_t first, std::uint32_t children) const {
