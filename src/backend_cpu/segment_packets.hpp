@@ -264,21 +264,28 @@ template <int N>
                                                    std::uint32_t accesses, const v4f* pm,
                                                    const PacketSchedule<N>& sc,
                                                    PacketLoopState& s) {
+  // Only the colour and the marched length (float sums) follow the lanes one by one; the integer
+  // counters, which the scalar loop bumps per sample, are added once per packet: the same totals.
   for (int l = 0; l < sc.m; ++l) {
-    s.accesses += accesses;
-    ++s.samples;
     s.a = s.a + splat(1.0f - s.a[3]) * pm[l];
     if (s.a[3] >= f.ert_opacity) {
+      const std::uint32_t done = std::uint32_t(l) + 1u;
+      s.samples += done;
+      s.accesses += done * accesses;
+      s.iterations += done - 1u;  // one per sample after the first
       s.saturated = true;
       s.t_now = sc.lane_t[l];
       s.j = s.j + std::uint32_t(l);
       return true;
     }
     s.marched = s.marched + sc.lane_seg[l];
-    if (l + 1 < sc.m) ++s.iterations;
   }
+  const std::uint32_t done = std::uint32_t(sc.m);
+  s.samples += done;
+  s.accesses += done * accesses;
+  s.iterations += done - 1u;
   s.t_now = sc.t_after;
-  s.j = s.j + std::uint32_t(sc.m);
+  s.j = s.j + done;
   if (sc.ends) return true;
   ++s.iterations;
   s.tm = sc.next_tm;

@@ -8,18 +8,24 @@
 // baseline copy is how the work is spread:
 //   - the schedule of a packet is computed for all eight lanes at once: step k of the grid is
 //     t_grid + float(j + k) * dt (resoct_grid_t) wherever those values strictly increase, which
-//     is checked, and the scalar schedule runs where they do not (steps below an ulp of t);
+//     is checked, and the scalar schedule runs where they do not (steps below an ulp of t); the
+//     lane that ends the packet is the first set bit of the lanes' end conditions, and the lanes'
+//     midpoints and lengths stay in vectors;
 //   - the eight trilinear footprints of u8 and u16 voxels are read with gathers, two voxels per
 //     32-bit word (x and x + 1 are adjacent); f32 voxels with scalar loads (faster than eight
 //     gathers); all are interpolated eight lanes wide;
-//   - the transfer function, the opacity correction and compositing stay per lane, in order.
+//   - the transfer function's LUT indices and fractions are computed eight lanes wide; a packet
+//     of full steps reads its colours from the step level's LUT per lane, other steps correct
+//     their opacity per lane, and compositing stays per lane, in order.
 // The target does not include FMA, so no multiply-add is contracted. Reading a u8 pair as a
 // 32-bit word reads up to two bytes past the pair: the backend's cache pool has
 // kCacheReadSlack bytes of slack after its last brick.
 #include <immintrin.h>
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "segment_packets.hpp"
 
@@ -152,22 +158,41 @@ struct TfIndex8 {
   return r;
 }
 
-// The schedule of an eight-lane packet (lanes from 1 on; lane 0 is set): the scalar loop's
-// control, computed for all lanes at once where the grid's steps strictly increase.
-[[gnu::target("avx2"), gnu::always_inline]] inline void schedule8(const kernel::ResoctFrame& f,
-                                                                  float dt, float t_exit,
-                                                                  float seg_next, float t_grid,
-                                                                  const PacketLoopState& s,
-                                                                  PacketSchedule<8>& sc) {
+// Lanes {x, v[0], ..., v[6]}: a vector moved up by one lane, x in lane 0.
+[[gnu::target("avx2"), gnu::always_inline]] inline v8f shift_in8(v8f v, float x) {
+  return __builtin_shuffle(v, splat8(x), v8i{8, 0, 1, 2, 3, 4, 5, 6});
+}
+// Bit k set where lane k's comparison mask is set.
+[[gnu::target("avx2"), gnu::always_inline]] inline unsigned lane_bits8(v8i mask) {
+  return unsigned(_mm256_movemask_ps(__m256(mask)));
+}
+
+// An eight-lane packet as vectors: its schedule (PacketSchedule, lanes 0 .. m - 1), and each
+// lane's midpoint and length, unused lanes repeating lane 0 so that their reads stay inside the
+// bricks.
+struct Packet8 {
+  PacketSchedule<8> sc;
+  v8f tm, seg;
+};
+
+// The next packet of the loop in state `s` (next_packet4 for eight lanes): lane 0 is the pending
+// sample; the scalar loop's control for lanes 1 .. 7 is computed for all lanes at once where the
+// grid's steps strictly increase.
+[[gnu::target("avx2"), gnu::always_inline]] inline void next_packet8(const kernel::ResoctFrame& f,
+                                                                     float dt, float t_exit,
+                                                                     float seg_next, float t_grid,
+                                                                     const PacketLoopState& s,
+                                                                     Packet8& p) {
   using namespace kernel;
+  PacketSchedule<8>& sc = p.sc;
   const float eps_dt = RESOCT_SEGMENT_EPS * dt;
   const v8f lane_index{1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, 7.0f, 8.0f};
   // Steps j + 1 .. j + 8 at once (resoct_grid_t: float(j + k) * dt, then + t_grid; j + 8 is
   // exact in float far beyond any iteration cap). Where they do not strictly increase (steps
   // below an ulp of t), resoct_grid_t's guard decides: the scalar schedule runs.
   const v8f starts = splat8(t_grid) + (splat8(float(s.j)) + lane_index) * splat8(dt);
-  bool increasing = starts[0] > s.t_now && float(s.j) + 8.0f < 16777216.0f;
-  for (int k = 1; k < 8; ++k) increasing = increasing && starts[k] > starts[k - 1];
+  const v8f lane_t = shift_in8(starts, s.t_now);
+  const bool increasing = lane_bits8(starts > lane_t) == 0xFFu && float(s.j) + 8.0f < 16777216.0f;
   if (increasing) {
     // resoct_segment_length: max(min(dt, t_exit - t), 0) with GLM's min (y < x ? y : x) and
     // max (x < y ? y : x).
@@ -175,39 +200,63 @@ struct TfIndex8 {
     const v8f segs = select8(rest < splat8(dt), rest, splat8(dt));
     const v8f seg_len = select8(segs < splat8(0.0f), splat8(0.0f), segs);
     const v8f mids = starts + splat8(0.5f) * seg_len;
-    for (int k = 1; k <= 8; ++k) {
+    // Lane k - 1 of these vectors is the candidate for lane k: the loop ends at the first k whose
+    // start leaves less than eps of a step, whose midpoint reaches seg_next, or that hits the
+    // iteration cap (the scalar loop's iterations + k - 1 >= max_iterations; iterations never
+    // exceeds the cap, the march checks it first).
+    unsigned fail = ~lane_bits8((rest > splat8(eps_dt)) & (mids < splat8(seg_next))) & 0xFFu;
+    const std::uint32_t room =
+        f.max_iterations > s.iterations ? f.max_iterations - s.iterations : 0u;
+    if (room < 8u) fail |= (0xFFu << room) & 0xFFu;
+    if (fail != 0u) {
+      const int k = std::countr_zero(fail) + 1;
       sc.t_after = starts[k - 1];
-      if (!(t_exit - sc.t_after > eps_dt) ||
-          s.iterations + std::uint32_t(k - 1) >= f.max_iterations || !(mids[k - 1] < seg_next)) {
-        sc.ends = true;
-        break;
-      }
-      sc.next_seg = seg_len[k - 1];
-      sc.next_tm = mids[k - 1];
-      if (k == 8) break;
-      sc.lane_tm[k] = sc.next_tm;
-      sc.lane_seg[k] = sc.next_seg;
-      sc.lane_t[k] = sc.t_after;
-      sc.m = k + 1;
+      sc.ends = true;
+      sc.m = k;
+    } else {
+      sc.t_after = starts[7];
+      sc.next_seg = seg_len[7];
+      sc.next_tm = mids[7];
+      sc.m = 8;
     }
+    const v8i used = v8i{0, 1, 2, 3, 4, 5, 6, 7} < splat8(std::int32_t(sc.m));
+    p.tm = select8(used, shift_in8(mids, s.tm), splat8(s.tm));
+    p.seg = select8(used, shift_in8(seg_len, s.seg), splat8(s.seg));
+    std::memcpy(sc.lane_t, &lane_t, sizeof(lane_t));
+    std::memcpy(sc.lane_seg, &p.seg, sizeof(p.seg));
   } else {
+    sc.lane_tm[0] = s.tm;
+    sc.lane_seg[0] = s.seg;
+    sc.lane_t[0] = s.t_now;
     schedule_lanes(f, dt, t_exit, seg_next, t_grid, s, sc);
+    for (int l = sc.m; l < 8; ++l) {
+      sc.lane_tm[l] = sc.lane_tm[0];
+      sc.lane_seg[l] = sc.lane_seg[0];
+    }
+    std::memcpy(&p.tm, sc.lane_tm, sizeof(p.tm));
+    std::memcpy(&p.seg, sc.lane_seg, sizeof(p.seg));
   }
 }
 
-// next_packet4 (segment_packets.hpp) for eight lanes, scheduled by schedule8.
-[[gnu::target("avx2"), gnu::always_inline]] inline void next_packet8(const kernel::ResoctFrame& f,
-                                                                     float dt, float t_exit,
-                                                                     float seg_next, float t_grid,
-                                                                     const PacketLoopState& s,
-                                                                     PacketSchedule<8>& sc) {
-  sc.lane_tm[0] = s.tm;
-  sc.lane_seg[0] = s.seg;
-  sc.lane_t[0] = s.t_now;
-  schedule8(f, dt, t_exit, seg_next, t_grid, s, sc);
-  for (int l = sc.m; l < 8; ++l) {
-    sc.lane_tm[l] = sc.lane_tm[0];
-    sc.lane_seg[l] = sc.lane_seg[0];
+// The premultiplied samples of a packet whose lanes are all full steps of a ray with a step
+// level: lane_sample's LUT branch, with the lanes' indices, fractions and 1 - fraction computed
+// eight at a time (the same IEEE operation per lane).
+[[gnu::target("avx2"), gnu::always_inline]] inline void level_samples8(const glm::vec4* level_lut,
+                                                                       const TfIndex8& ix, int m,
+                                                                       v4f* pm) {
+  alignas(32) std::int32_t idx[8];
+  alignas(32) float fr[8], omf[8];
+  alignas(32) std::int32_t nan[8];
+  const v8i i0 = select8(ix.nan, splat8(std::int32_t(0)), ix.i0);
+  const v8f one_minus = splat8(1.0f) - ix.fr;
+  std::memcpy(idx, &i0, sizeof(idx));
+  std::memcpy(fr, &ix.fr, sizeof(fr));
+  std::memcpy(omf, &one_minus, sizeof(omf));
+  std::memcpy(nan, &ix.nan, sizeof(nan));
+  for (int l = 0; l < m; ++l) {
+    const std::size_t i = std::size_t(idx[l]);
+    const v4f p = load4(level_lut[i]) * splat(omf[l]) + load4(level_lut[i + 1u]) * splat(fr[l]);
+    pm[l] = nan[l] != 0 || !(p[3] > 0.0f) ? splat(0.0f) : p;
   }
 }
 
@@ -229,17 +278,21 @@ struct TfIndex8 {
   const glm::vec4* level_lut = level_lut_of(ctx, f, src, step_level);
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
-    PacketSchedule<8> sc;
-    next_packet8(f, dt, t_exit, seg_next, t_grid, s, sc);
+    Packet8 p;
+    next_packet8(f, dt, t_exit, seg_next, t_grid, s, p);
+    const PacketSchedule<8>& sc = p.sc;
 
-    v8f tmv;
-    for (int l = 0; l < 8; ++l) tmv[l] = sc.lane_tm[l];
-    const v8f value = source_values8(ctx, src, brick, tmv);
+    const v8f value = source_values8(ctx, src, brick, p.tm);
     const TfIndex8 ix = tf_index8(value);
     v4f pm[8];
-    for (int l = 0; l < sc.m; ++l) {
-      pm[l] = lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], ix.nan[l] != 0, ix.i0[l],
-                          ix.fr[l]);
+    // Unused lanes repeat lane 0, so all eight are full steps when the used ones are.
+    if (level_lut != nullptr && lane_bits8(p.seg == splat8(dt)) == 0xFFu) {
+      level_samples8(level_lut, ix, sc.m, pm);
+    } else {
+      for (int l = 0; l < sc.m; ++l) {
+        pm[l] = lane_sample(f, src, level_lut, dt, sc.lane_seg[l], value[l], ix.nan[l] != 0,
+                            ix.i0[l], ix.fr[l]);
+      }
     }
     if (composite_lanes(f, mapped ? 1u : 0u, pm, sc, s)) break;
   }

@@ -137,10 +137,10 @@ inline std::uint32_t multi_channels(const KernelContext& ctx, const kernel::Reso
   const std::uint32_t k = multi_channels(ctx, f, src, values, n, step_level, ch, mapped);
   PacketLoopState s = packet_loop_begin(seg, tm, grid_j, t, acc, stats);
   for (;;) {
-    PacketSchedule<8> sc;
-    next_packet8(f, dt, t_exit, seg_next, t_grid, s, sc);
-    v8f tmv;
-    for (int l = 0; l < 8; ++l) tmv[l] = sc.lane_tm[l];
+    Packet8 p;
+    next_packet8(f, dt, t_exit, seg_next, t_grid, s, p);
+    const PacketSchedule<8>& sc = p.sc;
+    const v8f tmv = p.tm;
     v4f weighted[8];
     float combined[8];
     for (int l = 0; l < 8; ++l) {
