@@ -236,6 +236,15 @@ struct TfIndex4 {
   return r;
 }
 
+// A full step's premultiplied colour from a step level's corrected LUT
+// (resoct_step_lut_lookup, 0 where alpha is 0): entries i and i + 1 weighted by 1 - fr and fr,
+// i = 0 for a NaN value.
+[[gnu::always_inline]] inline v4f level_lut_sample(const glm::vec4* level_lut, std::size_t i,
+                                                   float one_minus_fr, float fr, bool nan) {
+  const v4f p = load4(level_lut[i]) * splat(one_minus_fr) + load4(level_lut[i + 1u]) * splat(fr);
+  return nan || !(p[3] > 0.0f) ? splat(0.0f) : p;
+}
+
 // Lane `l`'s premultiplied sample (resoct_mix_result of this one channel) from its normalized
 // value, LUT index i0 and fraction fr: a full step of a ray with a step level from the level's
 // LUT (resoct_step_lut_lookup, 0 where alpha is 0), any other step corrected per sample with the
@@ -246,9 +255,7 @@ struct TfIndex4 {
                                               float value, bool nan, std::int32_t i0, float fr) {
   using namespace kernel;
   if (level_lut != nullptr && seg == dt) {
-    const std::size_t i = nan ? 0u : std::size_t(i0);
-    const v4f p = load4(level_lut[i]) * splat(1.0f - fr) + load4(level_lut[i + 1u]) * splat(fr);
-    return nan || !(p[3] > 0.0f) ? splat(0.0f) : p;
+    return level_lut_sample(level_lut, nan ? 0u : std::size_t(i0), 1.0f - fr, fr, nan);
   }
   const vec4 rgba = resoct_tf_lookup(src.tf_slot, value);
   const float al = resoct_correct_opacity(rgba.a, resoct_step_ratio(seg, f.ref_step));

@@ -167,9 +167,9 @@ struct TfIndex8 {
   return unsigned(_mm256_movemask_ps(__m256(mask)));
 }
 
-// An eight-lane packet as vectors: its schedule (PacketSchedule, lanes 0 .. m - 1), and each
-// lane's midpoint and length, unused lanes repeating lane 0 so that their reads stay inside the
-// bricks.
+// An eight-lane packet as vectors: its schedule (PacketSchedule, lanes 0 .. m - 1; its lane_t
+// and lane_seg are set, its lane_tm only on the scalar path, so read `tm`), and each lane's
+// midpoint and length, unused lanes repeating lane 0 so that their reads stay inside the bricks.
 struct Packet8 {
   PacketSchedule<8> sc;
   v8f tm, seg;
@@ -239,8 +239,8 @@ struct Packet8 {
 }
 
 // The premultiplied samples of a packet whose lanes are all full steps of a ray with a step
-// level: lane_sample's LUT branch, with the lanes' indices, fractions and 1 - fraction computed
-// eight at a time (the same IEEE operation per lane).
+// level: level_lut_sample per lane, its index (0 for NaN), fraction and 1 - fraction computed
+// eight lanes at a time (the same IEEE operation per lane).
 [[gnu::target("avx2"), gnu::always_inline]] inline void level_samples8(const glm::vec4* level_lut,
                                                                        const TfIndex8& ix, int m,
                                                                        v4f* pm) {
@@ -254,9 +254,7 @@ struct Packet8 {
   std::memcpy(omf, &one_minus, sizeof(omf));
   std::memcpy(nan, &ix.nan, sizeof(nan));
   for (int l = 0; l < m; ++l) {
-    const std::size_t i = std::size_t(idx[l]);
-    const v4f p = load4(level_lut[i]) * splat(omf[l]) + load4(level_lut[i + 1u]) * splat(fr[l]);
-    pm[l] = nan[l] != 0 || !(p[3] > 0.0f) ? splat(0.0f) : p;
+    pm[l] = level_lut_sample(level_lut, std::size_t(idx[l]), omf[l], fr[l], nan[l] != 0);
   }
 }
 
