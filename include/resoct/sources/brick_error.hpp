@@ -35,9 +35,42 @@ inline constexpr std::uint64_t kBrickErrorMeasuredVoxels = std::uint64_t(1) << 2
 /// [0, 1] of the channel's value range, or 1 when nothing bounds it (a region without finite
 /// values, an empty range). Reads level-0 bricks of `source`; throws what it throws and
 /// Error(invalid_argument) naming "padded" for a wrongly sized buffer.
+/// `known_bound` is an upper bound on the error the caller already has (a source's analytic
+/// bound, lipschitz_brick_error_bound below): it stands in for the metadata bound where it is
+/// tighter, so it is what a brick too large to measure gets, and nothing is read where it
+/// already gives the tightest code. The result never exceeds it.
 double measure_brick_error(const BrickSource& source, BrickKey key,
                            std::span<const std::byte> padded,
-                           std::uint64_t max_level0_voxels = kBrickErrorMeasuredVoxels);
+                           std::uint64_t max_level0_voxels = kBrickErrorMeasuredVoxels,
+                           double known_bound = 1.0);
+
+/// What an error bound of a coarse brick rests on when the level-0 voxels follow a field
+/// known to vary slowly (a procedural source's, or any source that knows a Lipschitz constant).
+struct LipschitzErrorTerms {
+  /// L: |G(q) - G(p)| <= L |q - p| (Euclidean, level-0 voxel units) for a field G, in stored
+  /// value units per level-0 voxel. +infinity when none is known (the bound is then 1).
+  double lipschitz = 0.0;
+  /// The most any level-0 voxel differs from G at its centre (quantization: 0.5 for integer
+  /// types that round).
+  double voxel_error = 0.0;
+  /// The most any level-l voxel of the brick differs from the exact weighted mean of the
+  /// level-0 voxels its recursive box filter covers (downsample.hpp), in stored value units.
+  double level_error = 0.0;
+};
+
+/// An upper bound on measure_brick_error()'s quantity for brick `key` of hierarchy `h` (range
+/// fraction, at most 1), without reading a voxel. Since r_l(p) is a weighted mean of level-0
+/// voxels q (trilinear weights on the taps, box-filter weights under each tap), |r_l(p) - V0(p)|
+/// <= level_error + 2 voxel_error + L * sqrt(sum over axes of M_a), where M_a is the largest,
+/// over the brick's level-0 coordinates p_a, weighted mean of (q_a - p_a)^2: per axis the weights
+/// factor, and Jensen's inequality takes the mean distance under the square root. The taps
+/// follow the kernel's sampler through the halo exactly as measure_brick_error() does (border
+/// voxels repeated). A tap whose footprint is whole along the axis has uniform weights, second
+/// moment (f^2 - 1) / 12 + (centre - p)^2; one cut by the volume's end (recursive filter weights
+/// not uniform) counts its farthest voxel centre instead. Level 0 gives 0. Throws
+/// Error(out_of_range) for a key outside the hierarchy.
+double lipschitz_brick_error_bound(const BrickHierarchy& h, BrickKey key,
+                                   const LipschitzErrorTerms& terms);
 
 /// The least float >= `error` (a double), so that keeping an error in 4 bytes (HostBrick::error,
 /// the brick store's error section) never claims a tighter code than the measurement allows.

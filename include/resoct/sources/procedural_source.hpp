@@ -110,6 +110,17 @@ class ProceduralSource : public BrickSource {
   /// The documented bound (see file comment) on |level-l voxel - exact recursive downsampling of
   /// level 0|, in stored value units. 0 for exact levels.
   double coarse_error_bound(std::uint32_t level, std::uint32_t channel) const;
+  /// The analytic bound on brick `key`'s down-sampling error (measure_brick_error()'s quantity,
+  /// range fraction) from the field's Lipschitz constant: lipschitz_brick_error_bound() with
+  /// L = Field::lipschitz times the type's maximum, quantization 0.5 (integer types) and the
+  /// level's voxels within coarse_error_bound() plus the reference's own roundings (0.5 per
+  /// level) of the exact mean. Reads nothing. 1 where the field has no Lipschitz constant
+  /// (mandelbulb). Throws Error(out_of_range) for a key outside the hierarchy.
+  double brick_error_bound(BrickKey key) const;
+  /// measure_brick_error() with brick_error_bound() as the known bound: bricks too large to
+  /// measure (over kBrickErrorMeasuredVoxels level-0 voxels: 32³ bricks from level 4 up) get the
+  /// analytic bound instead of the far looser metadata spread; smaller ones are measured.
+  double brick_error(BrickKey key, std::span<const std::byte> padded) const override;
 
   /// Voxels of `box` (inside level `level`) of one channel, dense, x fastest, always evaluated
   /// (no constant-brick shortcut). Throws Error(out_of_range) for a bad channel and

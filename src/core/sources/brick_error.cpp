@@ -61,6 +61,40 @@ double lerp_taps(double a, double b, double w) noexcept {
   return (1.0 - w) * a + w * b;
 }
 
+// The largest, over level-0 coordinates x of [lo, hi) along one axis, weighted second moment of
+// (q - x - 1/2) over the level-0 voxel centres q the reconstruction at x + 1/2 draws on (see
+// lipschitz_brick_error_bound). `taps` index the padded brick; padded index i is level-l voxel
+// clamp(core_lo + i - halo) (read_brick repeats border voxels), whose footprint is
+// [j f, min((j + 1) f, extent0)).
+double axis_second_moment(const AxisTaps& taps, std::int64_t core_lo, std::int64_t halo,
+                          std::uint32_t factor_log2, std::uint64_t level_extent,
+                          std::uint64_t extent0) {
+  const double f = std::ldexp(1.0, int(factor_log2));
+  const auto footprint_moment = [&](std::int64_t i, double p) {
+    const std::int64_t j =
+        std::clamp<std::int64_t>(core_lo + i - halo, 0, std::int64_t(level_extent) - 1);
+    const double lo = std::ldexp(double(j), int(factor_log2));
+    const double hi = std::ldexp(double(j + 1), int(factor_log2));
+    if (hi <= double(extent0)) {
+      const double d = lo + 0.5 * f - p;
+      return (f * f - 1.0) / 12.0 + d * d;
+    }
+    const double a = lo + 0.5 - p;
+    const double b = double(extent0) - 0.5 - p;
+    return std::max(a * a, b * b);
+  };
+  double worst = 0.0;
+  for (std::size_t k = 0; k < taps.w.size(); ++k) {
+    const double p = double(taps.lo + std::int64_t(k)) + 0.5;
+    const double w = taps.w[k];
+    double m = 0.0;
+    if (w != 1.0) m += (1.0 - w) * footprint_moment(taps.i0[k], p);
+    if (w != 0.0) m += w * footprint_moment(taps.i0[k] + 1, p);
+    worst = std::max(worst, m);
+  }
+  return worst;
+}
+
 }  // namespace
 
 std::uint32_t brick_error_code(double error) noexcept {
@@ -79,8 +113,43 @@ float brick_error_to_float(double error) noexcept {
   return f;
 }
 
+double lipschitz_brick_error_bound(const BrickHierarchy& h, BrickKey key,
+                                   const LipschitzErrorTerms& terms) {
+  if (!h.contains(key)) {
+    throw Error(ErrorCode::out_of_range, "lipschitz_brick_error_bound: parameter 'key': level " +
+                                             std::to_string(key.level()) + " channel " +
+                                             std::to_string(key.channel()) +
+                                             " is not a brick of the hierarchy");
+  }
+  const std::uint32_t level = key.level();
+  if (level == 0) return 0.0;
+  const VolumeDesc& v = h.volume();
+  const ValueRange range = v.range(key.channel());
+  const double span = range.hi - range.lo;
+  if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
+  if (!(terms.lipschitz >= 0.0 && std::isfinite(terms.lipschitz))) return 1.0;
+  const Box3 box0 = h.level0_box(level, key.brick());
+  if (box0.empty()) return 0.0;
+  const BrickLayout& layout = h.layout();
+  const LevelInfo& li = h.level(level);
+  const Box3 core = h.core_box(level, key.brick());
+  const glm::uvec3 ps = layout.padded_size();
+  double moment = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const AxisTaps taps =
+        axis_taps(box0.lo[a], box0.hi[a], double(core.lo[a] << li.factor_log2[a]),
+                  std::ldexp(1.0, -int(li.factor_log2[a])), double(layout.halo), ps[a]);
+    moment += axis_second_moment(taps, core.lo[a], std::int64_t(layout.halo), li.factor_log2[a],
+                                 li.extent[a], v.extent[a]);
+  }
+  const double e =
+      terms.level_error + 2.0 * terms.voxel_error + terms.lipschitz * std::sqrt(moment);
+  return std::min(1.0, e / span);
+}
+
 double measure_brick_error(const BrickSource& source, BrickKey key,
-                           std::span<const std::byte> padded, std::uint64_t max_level0_voxels) {
+                           std::span<const std::byte> padded, std::uint64_t max_level0_voxels,
+                           double known_bound) {
   const BrickHierarchy& h = source.hierarchy();
   const BrickLayout& layout = h.layout();
   const VolumeDesc& v = h.volume();
@@ -108,7 +177,8 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
     wide.hi[a] = std::min<std::int64_t>(std::int64_t(v.extent[a]), box0.hi[a] + step);
   }
   const double spread = region_spread(source, key.channel(), wide);
-  const double bound = spread < 0.0 ? 1.0 : std::min(1.0, spread / span);
+  const double bound =
+      std::min(spread < 0.0 ? 1.0 : std::min(1.0, spread / span), std::max(0.0, known_bound));
   // Nothing measured could give a better code, or the measurement is too large to make.
   if (brick_error_code(bound) == kBrickErrorCodeBest ||
       std::uint64_t(box0.volume()) > max_level0_voxels) {
@@ -190,7 +260,7 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
       }
     }
   }
-  return std::min(1.0, worst / span);
+  return std::min(std::min(1.0, std::max(0.0, known_bound)), worst / span);
 }
 
 }  // namespace resoct

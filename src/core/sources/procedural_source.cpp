@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "resoct/sources/brick_error.hpp"
 #include "resoct/volume/dense_volume.hpp"
 #include "resoct/volume/downsample.hpp"
 #include "resoct/base/error.hpp"
@@ -267,6 +268,28 @@ double ProceduralSource::coarse_error_bound(std::uint32_t level, std::uint32_t c
   if (!std::isfinite(lip)) return std::numeric_limits<double>::infinity();
   const double q = spec_.type == VoxelType::f32 ? 1e-6 * (level + 2) : 0.5 * (level + 2);
   return lip * std::sqrt(d2) + q;
+}
+
+double ProceduralSource::brick_error_bound(BrickKey key) const {
+  if (!hierarchy_.contains(key)) {
+    throw Error(ErrorCode::out_of_range,
+                name_ + ": parameter 'key': level " + std::to_string(key.level()) + " channel " +
+                    std::to_string(key.channel()) + " is not a brick of the hierarchy");
+  }
+  const std::uint32_t level = key.level();
+  if (level == 0) return 0.0;
+  const bool integer = spec_.type != VoxelType::f32;
+  // f32: float(v) of a value in [0, 1] is within 2^-25 of it; 1e-7 per rounding is generous.
+  const double rounding = integer ? 0.5 : 1e-7;
+  LipschitzErrorTerms terms;
+  terms.lipschitz = field_->lipschitz(key.channel()) * type_scale(spec_.type);
+  terms.voxel_error = rounding;
+  terms.level_error = coarse_error_bound(level, key.channel()) + rounding * double(level);
+  return lipschitz_brick_error_bound(hierarchy_, key, terms);
+}
+
+double ProceduralSource::brick_error(BrickKey key, std::span<const std::byte> padded) const {
+  return measure_brick_error(*this, key, padded, kBrickErrorMeasuredVoxels, brick_error_bound(key));
 }
 
 void ProceduralSource::read_level0(std::uint32_t channel, const Box3& box,
