@@ -177,8 +177,8 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
     wide.hi[a] = std::min<std::int64_t>(std::int64_t(v.extent[a]), box0.hi[a] + step);
   }
   const double spread = region_spread(source, key.channel(), wide);
-  const double bound =
-      std::min(spread < 0.0 ? 1.0 : std::min(1.0, spread / span), std::max(0.0, known_bound));
+  const double cap = std::min(1.0, std::max(0.0, known_bound));
+  const double bound = std::min(cap, spread < 0.0 ? 1.0 : spread / span);
   // Nothing measured could give a better code, or the measurement is too large to make.
   if (brick_error_code(bound) == kBrickErrorCodeBest ||
       std::uint64_t(box0.volume()) > max_level0_voxels) {
@@ -260,7 +260,7 @@ double measure_brick_error(const BrickSource& source, BrickKey key,
       }
     }
   }
-  return std::min(std::min(1.0, std::max(0.0, known_bound)), worst / span);
+  return std::min(cap, worst / span);
 }
 
 }  // namespace resoct

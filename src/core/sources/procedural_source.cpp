@@ -271,20 +271,17 @@ double ProceduralSource::coarse_error_bound(std::uint32_t level, std::uint32_t c
 }
 
 double ProceduralSource::brick_error_bound(BrickKey key) const {
-  if (!hierarchy_.contains(key)) {
-    throw Error(ErrorCode::out_of_range,
-                name_ + ": parameter 'key': level " + std::to_string(key.level()) + " channel " +
-                    std::to_string(key.channel()) + " is not a brick of the hierarchy");
-  }
-  const std::uint32_t level = key.level();
-  if (level == 0) return 0.0;
-  const bool integer = spec_.type != VoxelType::f32;
-  // f32: float(v) of a value in [0, 1] is within 2^-25 of it; 1e-7 per rounding is generous.
-  const double rounding = integer ? 0.5 : 1e-7;
+  // lipschitz_brick_error_bound refuses a key outside the hierarchy (and answers 0 at level 0);
+  // the field and the level's bound are asked only for keys inside it.
   LipschitzErrorTerms terms;
-  terms.lipschitz = field_->lipschitz(key.channel()) * type_scale(spec_.type);
-  terms.voxel_error = rounding;
-  terms.level_error = coarse_error_bound(level, key.channel()) + rounding * double(level);
+  if (hierarchy_.contains(key) && key.level() > 0) {
+    // f32: float(v) of a value in [0, 1] is within 2^-25 of it; 1e-7 per rounding is generous.
+    const double rounding = spec_.type != VoxelType::f32 ? 0.5 : 1e-7;
+    terms.lipschitz = field_->lipschitz(key.channel()) * type_scale(spec_.type);
+    terms.voxel_error = rounding;
+    terms.level_error =
+        coarse_error_bound(key.level(), key.channel()) + rounding * double(key.level());
+  }
   return lipschitz_brick_error_bound(hierarchy_, key, terms);
 }
 
