@@ -86,20 +86,10 @@ inline float clamp_coord(float v, float hi) {
   return v > 0.0f ? (v < hi ? v : hi) : 0.0f;
 }
 
-// Always inlined into the kernel's sampling: left to the growth heuristics, GCC moved it out of
-// the march once the kernel unit grew (slices and lens), +2 % instructions per frame (callgrind).
+// The trilinear interpolation of the 2x2x2 cell whose lowest voxel is at index i.
 template <class T>
-[[gnu::always_inline]] inline float trilinear(const std::byte* brick, const BrickGeometry& g,
-                                              glm::vec3 pos) {
-  // Clamp to the outermost voxel centres (clamp-to-edge), then interpolate the 2x2x2 cell.
-  const float cx = clamp_coord(pos.x - 0.5f, g.hi.x);
-  const float cy = clamp_coord(pos.y - 0.5f, g.hi.y);
-  const float cz = clamp_coord(pos.z - 0.5f, g.hi.z);
-  const int x0 = std::min(int(cx), g.last_cell.x);
-  const int y0 = std::min(int(cy), g.last_cell.y);
-  const int z0 = std::min(int(cz), g.last_cell.z);
-  const float fx = cx - float(x0), fy = cy - float(y0), fz = cz - float(z0);
-  const std::size_t i = std::size_t(z0) * g.slice + std::size_t(y0) * g.row + std::size_t(x0);
+[[gnu::always_inline]] inline float interpolate_cell(const std::byte* brick, const BrickGeometry& g,
+                                                     std::size_t i, float fx, float fy, float fz) {
   const std::size_t dx = g.dx, dy = g.dy, dz = g.dz;
   const float v000 = load_voxel<T>(brick, i), v100 = load_voxel<T>(brick, i + dx);
   const float v010 = load_voxel<T>(brick, i + dy), v110 = load_voxel<T>(brick, i + dy + dx);
@@ -113,6 +103,53 @@ template <class T>
   const float c0 = c00 + fy * (c10 - c00);
   const float c1 = c01 + fy * (c11 - c01);
   return c0 + fz * (c1 - c0);
+}
+
+// Always inlined into the kernel's sampling: left to the growth heuristics, GCC moved it out of
+// the march once the kernel unit grew (slices and lens), +2 % instructions per frame (callgrind).
+template <class T>
+[[gnu::always_inline]] inline float trilinear(const std::byte* brick, const BrickGeometry& g,
+                                              glm::vec3 pos) {
+  // Clamp to the outermost voxel centres (clamp-to-edge), then interpolate the 2x2x2 cell.
+  const float cx = clamp_coord(pos.x - 0.5f, g.hi.x);
+  const float cy = clamp_coord(pos.y - 0.5f, g.hi.y);
+  const float cz = clamp_coord(pos.z - 0.5f, g.hi.z);
+  const int x0 = std::min(int(cx), g.last_cell.x);
+  const int y0 = std::min(int(cy), g.last_cell.y);
+  const int z0 = std::min(int(cz), g.last_cell.z);
+  const std::size_t i = std::size_t(z0) * g.slice + std::size_t(y0) * g.row + std::size_t(x0);
+  return interpolate_cell<T>(brick, g, i, cx - float(x0), cy - float(y0), cz - float(z0));
+}
+
+// The six gradient taps of a sample (kernel/gradient.glsl.h, RESOCT_SAMPLE_CACHE_TAPS): the
+// trilinear values at pos ± one voxel per axis (minus only when `central`). Where every tap's
+// cell lies inside the padded brick, the taps are the neighbouring cells with the sample's own
+// fractions: one clamp, floor and fraction for all six (and the compiler may merge the loads the
+// cells share); elsewhere each tap is its own lookup, clamped like any sample.
+template <class T>
+[[gnu::always_inline]] inline void trilinear_taps(const std::byte* brick, const BrickGeometry& g,
+                                                  glm::vec3 pos, bool central, glm::vec3& plus,
+                                                  glm::vec3& minus) {
+  const float cx = pos.x - 0.5f, cy = pos.y - 0.5f, cz = pos.z - 0.5f;
+  const float lo = central ? 1.0f : 0.0f;
+  if (cx >= lo && cy >= lo && cz >= lo && cx < float(g.last_cell.x) && cy < float(g.last_cell.y) &&
+      cz < float(g.last_cell.z)) {
+    const int x0 = int(cx), y0 = int(cy), z0 = int(cz);
+    const float fx = cx - float(x0), fy = cy - float(y0), fz = cz - float(z0);
+    const std::size_t i = std::size_t(z0) * g.slice + std::size_t(y0) * g.row + std::size_t(x0);
+    const std::size_t dx = g.dx, dy = g.dy, dz = g.dz;
+    auto cell = [&](std::size_t j) { return interpolate_cell<T>(brick, g, j, fx, fy, fz); };
+    plus = glm::vec3(cell(i + dx), cell(i + dy), cell(i + dz));
+    minus = central ? glm::vec3(cell(i - dx), cell(i - dy), cell(i - dz)) : glm::vec3(0.0f);
+    return;
+  }
+  for (int a = 0; a < 3; ++a) {
+    glm::vec3 q = pos;
+    q[a] = pos[a] + 1.0f;
+    plus[a] = trilinear<T>(brick, g, q);
+    q[a] = pos[a] - 1.0f;
+    minus[a] = central ? trilinear<T>(brick, g, q) : 0.0f;
+  }
 }
 
 }  // namespace resoct::cpu::detail
@@ -172,6 +209,21 @@ inline float resoct_sample_cache(uint cache_slot, vec3 pos) {
   }
   return 0.0f;
 }
+inline void resoct_sample_cache_taps_cpu(uint cache_slot, vec3 pos, bool central, vec3& plus,
+                                         vec3& minus) {
+  const auto& c = *cpu::detail::t_ctx;
+  const std::byte* brick = c.cache + std::size_t(cache_slot) * c.brick_bytes;
+  switch (c.type) {
+    case VoxelType::u8:
+      return cpu::detail::trilinear_taps<std::uint8_t>(brick, c.geometry, pos, central, plus,
+                                                       minus);
+    case VoxelType::u16:
+      return cpu::detail::trilinear_taps<std::uint16_t>(brick, c.geometry, pos, central, plus,
+                                                        minus);
+    case VoxelType::f32:
+      return cpu::detail::trilinear_taps<float>(brick, c.geometry, pos, central, plus, minus);
+  }
+}
 inline void resoct_report_request(uint device_key) {
   cpu::detail::t_ctx->brick_requests->insert(device_key);
 }
@@ -193,6 +245,7 @@ inline void resoct_mark_used(uint cache_slot) {
 #include "segment_packets_multi.hpp"
 #define RESOCT_SEGMENT_SAMPLES ::resoct::cpu::detail::segment_samples_packets
 #define RESOCT_SEGMENT_SAMPLES_MULTI ::resoct::cpu::detail::segment_samples_multi_packets
+#define RESOCT_SAMPLE_CACHE_TAPS ::resoct::kernel::resoct_sample_cache_taps_cpu
 #include "resoct/kernel/traverse.glsl.h"
 
 namespace resoct::cpu::detail {

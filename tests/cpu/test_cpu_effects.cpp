@@ -116,7 +116,8 @@ double fraction_above(const Image& a, const Image& b, double tol) {
 // exact TF, 1/16 steps, exact crossings): the kernel samples at 1/4 voxel in float through a
 // LUT, so colours differ by a few 1e-3; a pixel whose ray grazes the surface can miss (or
 // catch) a crossing the finer reference catches (or misses), which bounds the share of
-// differing pixels rather than their difference.
+// differing pixels rather than their difference. Shaded DVR measured max 3.8e-3, RMSE 4.9e-4
+// (both stencils); gradient taps two voxels away on one axis give max 0.12-0.19, RMSE 8e-3-2e-2.
 TEST(CpuEffects, ShadingAndIsosurfacesMatchTheReferenceRenderer) {
   ProceduralSource src("procedural:sphere:32x32x32", bricks8());
   const VolumeDesc& v = src.hierarchy().volume();
@@ -133,8 +134,8 @@ TEST(CpuEffects, ShadingAndIsosurfacesMatchTheReferenceRenderer) {
     const Rendered r = render_cpu(rs, s);
     const Image ref = render_reference(s, v, vox);
     const ImageDiff d = compare_images(r.image, ref);
-    EXPECT_LT(d.rmse_rgb, 5e-3) << "shaded dvr";
-    EXPECT_LT(max_diff(r.image, ref), 3e-2) << "shaded dvr";
+    EXPECT_LT(d.rmse_rgb, 1.5e-3) << "shaded dvr";
+    EXPECT_LT(max_diff(r.image, ref), 1e-2) << "shaded dvr";
     std::printf("shaded DVR vs reference: max %.2e rmse %.2e\n", max_diff(r.image, ref),
                 d.rmse_rgb);
   }

@@ -63,12 +63,18 @@ RESOCT_FN float resoct_isovalue(RESOCT_IN(ResoctSlotInfo) s, uint k) {
   return k == 0u ? s.iso0 : (k == 1u ? s.iso1 : (k == 2u ? s.iso2 : s.iso3));
 }
 
-/// Lit colour of a surface or sample of slot `s` at `level` and the position (cell, frac).
+/// Lit colour of a surface or sample of slot `s` at `level` and the position (cell, frac). When
+/// the position is the march's sample at t whose value came from `src` at the same level
+/// (`at_sample`), the gradient taps read the source's brick directly.
 RESOCT_FX_FN vec3 resoct_fx_shade(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
                                   ResoctFxRayConst rc, RESOCT_IN(ResoctSlotInfo) s, uint level,
                                   uint lod, ivec3 cell, vec3 frac, float value, vec3 rgb,
-                                  bool cast_shadow, RESOCT_INOUT(ResoctRayStats) st) {
-  vec3 g = resoct_gradient(sp, p, s, level, cell, frac, value);
+                                  bool cast_shadow, bool at_sample, RESOCT_IN(ResoctSource) src,
+                                  float t, RESOCT_INOUT(ResoctRayStats) st) {
+  vec3 g;
+  if (!(at_sample && src.level == level && resoct_source_gradient(sp, p, src, t, cell, value, g))) {
+    g = resoct_gradient(sp, p, s, level, cell, frac, value);
+  }
   st.gradient_evals = st.gradient_evals + 1u;
   vec3 pos_box = (vec3(cell) + frac) / resoct_fx_voxels_per_box(p);
   vec3 light = resoct_light_vector(p, pos_box, rc.dir_box);
@@ -122,16 +128,16 @@ RESOCT_FN bool resoct_fx_iso_hit(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(Res
 }
 
 /// One channel's value at a sample under the declared effects (see the file comment). `level`
-/// is the level the value came from, `lod` the view LOD level, `seg` the segment length. The
-/// lighting code appears once (one call of resoct_fx_shade) so that GPU compilers, which inline
-/// everything, compile it once.
+/// is the level the value came from, `src` the segment's source of the channel, `lod` the view
+/// LOD level, `seg` the segment length. The lighting code appears once (one call of
+/// resoct_fx_shade) so that GPU compilers, which inline everything, compile it once.
 RESOCT_FX_FN void resoct_fx_channel(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
                                     ResoctFxRayConst rc, uint c, RESOCT_IN(ResoctSlotInfo) s,
-                                    float value, uint level, uint lod, float seg, float tm,
-                                    ivec3 cell, vec3 frac, RESOCT_INOUT(ResoctFxRay) fx,
-                                    RESOCT_INOUT(ResoctPreintRay) pr, RESOCT_INOUT(vec4) weighted,
-                                    RESOCT_INOUT(float) combined, RESOCT_INOUT(vec4) acc,
-                                    RESOCT_INOUT(ResoctRayStats) st) {
+                                    RESOCT_IN(ResoctSource) src, float value, uint level, uint lod,
+                                    float seg, float tm, ivec3 cell, vec3 frac,
+                                    RESOCT_INOUT(ResoctFxRay) fx, RESOCT_INOUT(ResoctPreintRay) pr,
+                                    RESOCT_INOUT(vec4) weighted, RESOCT_INOUT(float) combined,
+                                    RESOCT_INOUT(vec4) acc, RESOCT_INOUT(ResoctRayStats) st) {
   RESOCT_IF_FX(RESOCT_EFFECT_PROJECTION) {
     if (s.mode == RESOCT_CHANNEL_MIP) {
       fx.proj[c] = max(fx.proj[c], clamp(value, 0.0f, 1.0f));
@@ -174,7 +180,7 @@ RESOCT_FX_FN void resoct_fx_channel(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(
   }
   if (lit && a > 0.0f) {
     rgb = RESOCT_FX(resoct_fx_shade)(sp, p, rc, s, pl, lod, pc, pf, pv, rgb,
-                                     surface || a > RESOCT_SHADOW_MIN_ALPHA, st);
+                                     surface || a > RESOCT_SHADOW_MIN_ALPHA, !surface, src, tm, st);
   }
   RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
     if (!surface) resoct_preint_set_tail_colour(pr, c, rgb);

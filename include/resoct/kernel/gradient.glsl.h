@@ -19,6 +19,13 @@
 // gradient effects by the scene validation (trilinear sampling itself has seams there).
 // Gradient taps never request bricks.
 //
+// At a sample of the march (not an isosurface hit) whose value came from a mapped brick of the
+// same level, resoct_source_gradient reads the taps from that brick without a page lookup,
+// wherever the six taps' trilinear cells lie inside its padded voxels and no tap is clamped to
+// the volume: the halo holds the neighbouring bricks' voxels, so this is the same field the
+// lookups above read. Elsewhere (near the padded brick's faces with a halo of 1, at the volume's
+// faces, at substitutes) resoct_gradient does the work.
+//
 // Accessors: as listed in traverse.glsl.h.
 #ifndef RESOCT_KERNEL_GRADIENT_GLSL_H
 #define RESOCT_KERNEL_GRADIENT_GLSL_H
@@ -145,6 +152,68 @@ RESOCT_FN float resoct_gradient_tap(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(
     }
   }
   return resoct_entry_normalized(sp, s, e, L, b, cell, frac, fallback);
+}
+
+#ifndef RESOCT_SAMPLE_CACHE_TAPS
+/// Raw values of a cache slot's padded brick at `pos` plus (and, when `central`, minus) one voxel
+/// along each axis: the gradient taps of a sample. A backend may define RESOCT_SAMPLE_CACHE_TAPS
+/// before including the kernel to compute the six lookups together (the CPU backend shares their
+/// cell weights); this is the portable version.
+RESOCT_FN void resoct_sample_cache_taps(uint cache_slot, vec3 pos, bool central,
+                                        RESOCT_OUT(vec3) plus, RESOCT_OUT(vec3) minus) {
+  plus = vec3(0.0f);
+  minus = vec3(0.0f);
+  for (int a = 0; a < 3; ++a) {
+    vec3 q = pos;
+    q[a] = pos[a] + 1.0f;
+    plus[a] = resoct_sample_cache(cache_slot, q);
+    if (central) {
+      q[a] = pos[a] - 1.0f;
+      minus[a] = resoct_sample_cache(cache_slot, q);
+    }
+  }
+}
+#define RESOCT_SAMPLE_CACHE_TAPS resoct_sample_cache_taps
+#endif
+
+/// resoct_gradient at a sample of the march whose value came from the mapped source `src` (at
+/// ray parameter t, level-0 cell `cell`), without a page lookup: the taps, one voxel of the
+/// source's level from the sample's padded position, are read from the source's brick wherever
+/// their trilinear cells lie inside its padded voxels (the halo holds the neighbouring bricks'
+/// voxels, so this is the field resoct_gradient reads through the page table). False, leaving the
+/// work to resoct_gradient, where a tap would leave the padded brick or be clamped to the
+/// volume. The taps' positions round like the sample's (affine in t) rather than like
+/// resoct_gradient's (from the cell): the results differ in the last bits.
+RESOCT_FN bool resoct_source_gradient(RESOCT_IN(ResoctSampleParams) sp, RESOCT_IN(ResoctFxParams) p,
+                                      RESOCT_IN(ResoctSource) src, float t, ivec3 cell,
+                                      float center, RESOCT_OUT(vec3) g) {
+  g = vec3(0.0f);
+  if (src.kind != RESOCT_CH_VALUE || src.cache_slot == RESOCT_SOURCE_NO_SLOT) return false;
+  ivec3 h = ivec3(uvec3(1u) << resoct_level_factor(resoct_read_level(src.level)));
+  bool central = p.gradient_forward == 0u;
+  ivec3 hi = ivec3(int(p.extent_x) - 1, int(p.extent_y) - 1, int(p.extent_z) - 1);
+  for (int a = 0; a < 3; ++a) {
+    if (cell[a] > hi[a] - h[a] || (central && cell[a] < h[a])) return false;
+  }
+  vec3 pos = src.ray_base + t * src.ray_dir;
+  // Trilinear cell coordinates of the taps, unclamped in [0, padded - 1].
+  vec3 c = pos - vec3(0.5f);
+  vec3 last = vec3(resoct_frame_brick_size(sp) + uvec3(2u * sp.halo)) - vec3(1.0f);
+  if (any(lessThan(c, vec3(central ? 1.0f : 0.0f))) || any(greaterThan(c + vec3(1.0f), last))) {
+    return false;
+  }
+  vec3 plus;
+  vec3 minus;
+  RESOCT_SAMPLE_CACHE_TAPS(src.cache_slot, pos, central, plus, minus);
+  vec3 box_h = vec3(h) / resoct_fx_voxels_per_box(p);
+  vec3 vp = (plus - vec3(src.range_lo)) * src.inv_range_width;
+  if (central) {
+    vec3 vm = (minus - vec3(src.range_lo)) * src.inv_range_width;
+    g = (vp - vm) / (2.0f * box_h);
+  } else {
+    g = (vp - vec3(center)) / box_h;
+  }
+  return true;
 }
 
 /// Box-space gradient of the normalized field of slot `s` at `level` (see the file comment).

@@ -576,8 +576,8 @@ RESOCT_FX_FN vec4 resoct_render_pixel_fx(RESOCT_FRAME_IN f, uint px, uint py,
           for (uint c = 0u; c < n; ++c) {
             if (((fx_have >> c) & 1u) == 0u) continue;
             RESOCT_FX(resoct_fx_channel)
-            (sp, fxp, rc, c, resoct_read_slot(bank + c), fx_value[c], fx_level[c], seg_lod, seg, tm,
-             cell, frac, fx, pr, weighted, combined, acc, stats);
+            (sp, fxp, rc, c, resoct_read_slot(bank + c), src[c], fx_value[c], fx_level[c], seg_lod,
+             seg, tm, cell, frac, fx, pr, weighted, combined, acc, stats);
           }
         }
         RESOCT_IF_FX(RESOCT_EFFECT_PREINT) {
